@@ -1,0 +1,287 @@
+//! `photonmap`: renders the built-in TNCG15 room with photon mapping.
+//! A thin layer: parse and check the options, render, write, summarise.
+
+use clap::Parser;
+use photonmap::error::Error;
+use photonmap::film::ToneMap;
+use photonmap::metrics::compare;
+use photonmap::output::{check_writable, read_exr, write};
+use photonmap::progress::Mode;
+use photonmap::render::{render, Settings, Stats};
+use photonmap::scene::{Eye, Scene};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Photon-mapping renderer (Jensen: caustic and global photon maps, final
+/// gathering) for the TNCG15 hexagonal room with a glass sphere's caustic.
+#[derive(Parser, Debug)]
+#[command(
+    version,
+    about,
+    after_help = "Example: photonmap --photons 1e6 out.exr -o out.png"
+)]
+struct Cli {
+    /// Output images; the extension picks the format: .exr (linear float
+    /// radiance), .png or .ppm (8-bit, tone-mapped).
+    #[arg(value_name = "OUT")]
+    outputs: Vec<PathBuf>,
+    /// More output images (repeatable), as for OUT.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    more_outputs: Vec<PathBuf>,
+    /// Photons emitted for the global map (1e6, 2.5e5 and 1000000 all work).
+    #[arg(long, default_value = "1e6", value_parser = parse_count)]
+    photons: u64,
+    /// Photons emitted towards mirrors and glass for the caustic map
+    /// [default: the same as --photons].
+    #[arg(long, value_parser = parse_count)]
+    caustic_photons: Option<u64>,
+    /// Jittered camera samples per pixel (stratified when a square).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    spp: u32,
+    /// Seed of every random stream: the same seed gives the same image on any
+    /// number of threads.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Eye position: 1 = (-2,0,0), 53 degree view; 2 = (-1,0,0), 90 degrees.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
+    eye: u8,
+    /// Worker threads [default: all cores].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    threads: Option<u32>,
+    /// Image width in pixels (the image plane stays the course's 2 x 2 square).
+    #[arg(long, default_value_t = 800, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 800, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    height: u32,
+    /// Nearest photons per global-map irradiance estimate.
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    k: u32,
+    /// Nearest photons per caustic estimate.
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    k_caustic: u32,
+    /// Largest search radius of a global-map estimate, in scene units
+    /// [default: 5% of the scene's diagonal].
+    #[arg(long, value_parser = parse_radius)]
+    max_radius: Option<f32>,
+    /// Largest search radius of a caustic estimate [default: 1% of the diagonal].
+    #[arg(long, value_parser = parse_radius)]
+    caustic_radius: Option<f32>,
+    /// Final-gather rays per diffuse camera hit (0: no indirect light).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(0..=65_536))]
+    gather_rays: u32,
+    /// Shadow rays per light per diffuse camera hit.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    shadow_rays: u32,
+    /// Samples of the light seen in pixels on the rim of a light's image
+    /// (directly or in mirrors and glass; 0: no extra samples).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(0..=1_000_000))]
+    edge_spp: u32,
+    /// Tone mapping of 8-bit outputs: linear (255.99 / i_max) or sqrt.
+    #[arg(long, value_enum, default_value_t = ToneMap::Linear)]
+    tonemap: ToneMap,
+    /// Radiance multiplier applied before tone mapping 8-bit outputs
+    /// (values past the maximum clamp).
+    #[arg(long, default_value_t = 1.0, value_parser = parse_exposure)]
+    exposure: f32,
+    /// Score the render against a reference EXR of the default scene (the
+    /// metric of shared/refs/metrics.py) and print the numbers.
+    #[arg(long, value_name = "REF.exr")]
+    reference: Option<PathBuf>,
+    /// No progress bars and no summary.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// A photon count: an integer written plainly or in e-notation.
+fn parse_count(s: &str) -> Result<u64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number (try 1e6 or 250000)"))?;
+    if !v.is_finite() || v < 0.0 {
+        return Err(format!("'{s}' must be zero or a positive count"));
+    }
+    if v.fract() != 0.0 {
+        return Err(format!("'{s}' is not a whole number of photons"));
+    }
+    // Photon indices are 32-bit in the kd-tree; beyond this the maps would
+    // not fit in memory on any machine this runs on anyway.
+    const MAX: f64 = 1e9;
+    if v > MAX {
+        return Err(format!("'{s}' is more than the 1e9 photons a map can hold"));
+    }
+    Ok(v as u64)
+}
+
+fn parse_radius(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("'{s}' must be a positive distance")),
+    }
+}
+
+fn parse_exposure(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("'{s}' must be a positive factor")),
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("photonmap: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<(), Error> {
+    let outputs: Vec<PathBuf> = cli
+        .outputs
+        .iter()
+        .chain(&cli.more_outputs)
+        .cloned()
+        .collect();
+    if outputs.is_empty() {
+        return Err(Error::Invalid(
+            "no output file given (e.g. photonmap out.exr)".into(),
+        ));
+    }
+    // Every output path is checked before any time is spent rendering.
+    for path in &outputs {
+        check_writable(path)?;
+    }
+    let reference = cli.reference.as_deref().map(read_exr).transpose()?;
+    if let Some(threads) = cli.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads as usize)
+            .build_global()
+            .map_err(|e| Error::Invalid(format!("--threads: {e}")))?;
+    }
+    let settings = Settings {
+        photons: cli.photons,
+        caustic_photons: cli.caustic_photons.unwrap_or(cli.photons),
+        spp: cli.spp,
+        seed: cli.seed,
+        width: cli.width,
+        height: cli.height,
+        k_global: cli.k as usize,
+        k_caustic: cli.k_caustic as usize,
+        r_global: cli.max_radius,
+        r_caustic: cli.caustic_radius,
+        gather_rays: cli.gather_rays,
+        shadow_rays: cli.shadow_rays,
+        edge_spp: cli.edge_spp,
+        ..Settings::default()
+    };
+    let scene = Scene::tncg15(if cli.eye == 2 { Eye::Two } else { Eye::One });
+    if settings.photons == 0 && !cli.quiet {
+        eprintln!("photonmap: warning: --photons 0: no global map, so indirect light is missing");
+    }
+    if settings.caustic_photons == 0 && !cli.quiet {
+        eprintln!("photonmap: warning: no caustic photons: caustics are missing");
+    }
+    let start = Instant::now();
+    let (film, stats) = render(&scene, &settings, Mode::detect(cli.quiet));
+    let t = Instant::now();
+    for path in &outputs {
+        write(path, &film, cli.tonemap, cli.exposure)?;
+    }
+    let write_time = t.elapsed();
+    if !cli.quiet {
+        summary(&stats, &settings, write_time, start.elapsed());
+    }
+    if stats.nonfinite > 0 {
+        let (pixel, estimator) = stats.first_nonfinite.unwrap_or((0, "?"));
+        eprintln!(
+            "photonmap: warning: {} non-finite samples were dropped; first in the {estimator} estimate at pixel ({}, {})",
+            stats.nonfinite,
+            pixel % settings.width as u64,
+            pixel / settings.width as u64
+        );
+    }
+    if let Some(reference) = reference {
+        let m = compare(&film, &reference).ok_or_else(|| {
+            Error::Invalid(format!(
+                "--reference: a {}x{} image cannot be compared with a {}x{} reference",
+                film.width, film.height, reference.width, reference.height
+            ))
+        })?;
+        println!(
+            "{{\"seconds\": {:.3}, \"rmse\": {:.6}, \"relmse\": {:.6}, \"caustic_rmse\": {:.6}, \"mean_x\": {:.6}, \"mean_r\": {:.6}, \"caustic_mean_x\": {:.6}, \"caustic_mean_r\": {:.6}, \"nan_count\": {}}}",
+            start.elapsed().as_secs_f64(),
+            m.rmse,
+            m.relmse,
+            m.caustic_rmse,
+            m.mean_x,
+            m.mean_r,
+            m.caustic_mean_x,
+            m.caustic_mean_r,
+            m.nan_count
+        );
+    }
+    Ok(())
+}
+
+fn summary(
+    s: &Stats,
+    settings: &Settings,
+    write_time: std::time::Duration,
+    total: std::time::Duration,
+) {
+    let mrays = |rays: u64, d: std::time::Duration| rays as f64 / d.as_secs_f64().max(1e-9) / 1e6;
+    eprintln!(
+        "photonmap summary ({} threads)",
+        rayon::current_num_threads()
+    );
+    eprintln!(
+        "  global map:  {:>10} photons emitted, {:>10} stored",
+        s.global_emitted, s.global_stored
+    );
+    eprintln!(
+        "  caustic map: {:>10} photons emitted, {:>10} stored ({:.1}% first hit mirror/glass)",
+        s.caustic_emitted,
+        s.caustic_stored,
+        100.0 * s.caustic_aimed_hits as f64 / s.caustic_emitted.max(1) as f64
+    );
+    eprintln!(
+        "  kd-trees:    {} + {} photons, {:.1} MB; irradiance cache {} points; radius caps {:.3} (global) {:.3} (caustic)",
+        s.global_stored,
+        s.caustic_stored,
+        s.map_bytes as f64 / 1e6,
+        s.cache_points,
+        s.r_global,
+        s.r_caustic
+    );
+    eprintln!(
+        "  photon pass  {:>8.3} s  {:>7.2} M photons/s  {:>7.2} M rays/s",
+        s.photon_time.as_secs_f64(),
+        (s.global_emitted + s.caustic_emitted) as f64 / s.photon_time.as_secs_f64().max(1e-9) / 1e6,
+        mrays(s.photon_rays, s.photon_time)
+    );
+    eprintln!(
+        "  map build    {:>8.3} s  (kd-trees + irradiance cache)",
+        s.build_time.as_secs_f64()
+    );
+    eprintln!(
+        "  camera pass  {:>8.3} s  {:>7.2} M rays/s  ({} x {}, {} spp, {} gather rays, {} shadow rays)",
+        s.camera_time.as_secs_f64(),
+        mrays(s.camera_rays, s.camera_time),
+        settings.width,
+        settings.height,
+        settings.spp,
+        settings.gather_rays,
+        settings.shadow_rays
+    );
+    eprintln!(
+        "               {} pixels on the rim of a light's image took {} extra samples",
+        s.edge_pixels, settings.edge_spp
+    );
+    eprintln!("  write        {:>8.3} s", write_time.as_secs_f64());
+    eprintln!("  total        {:>8.3} s", total.as_secs_f64());
+}

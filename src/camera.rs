@@ -1,0 +1,87 @@
+//! The course's pinhole camera: an eye point and an image plane given by its
+//! four corners; a pixel's sample points are bilinear in the corners, and the
+//! pixel value is the box-filtered radiance through the pixel's square.
+
+use crate::math::{Ray, Vertex};
+use glam::{Vec2, Vec3};
+
+#[derive(Clone, Copy, Debug)]
+pub struct Camera {
+    pub eye: Vertex,
+    /// Corner at the top left of the written image.
+    upper_left: Vertex,
+    /// From the top-left to the top-right corner.
+    across: Vec3,
+    /// From the top-left to the bottom-left corner.
+    down: Vec3,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Camera {
+    /// `corners` in the course's order c1..c4 = (0,-1,-1), (0,1,-1), (0,1,1),
+    /// (0,-1,1), i.e. lower-right, lower-left, upper-left, upper-right as seen
+    /// from the eye (+y is to the left of the picture).
+    pub fn from_corners(eye: Vertex, corners: [Vertex; 4], width: u32, height: u32) -> Self {
+        let [lower_right, lower_left, upper_left, upper_right] = corners;
+        let _ = lower_right;
+        Camera {
+            eye,
+            upper_left,
+            across: upper_right - upper_left,
+            down: lower_left - upper_left,
+            width,
+            height,
+        }
+    }
+
+    /// The same view at another resolution.
+    pub fn with_resolution(mut self, width: u32, height: u32) -> Self {
+        self.width = width;
+        self.height = height;
+        self
+    }
+
+    /// The ray through image position (`col` + u.x, `row` + u.y), row 0 at the top.
+    pub fn ray(&self, col: u32, row: u32, u: Vec2) -> Ray {
+        let fx = (col as f32 + u.x) / self.width as f32;
+        let fy = (row as f32 + u.y) / self.height as f32;
+        let p = self.upper_left + fx * self.across + fy * self.down;
+        Ray::new(self.eye, (p - self.eye).normalize())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::scene::{Eye, Scene};
+    use glam::{Vec2, Vec3};
+
+    #[test]
+    fn pixel_centres_follow_the_course_formula() {
+        let cam = Scene::tncg15(Eye::One).camera;
+        // Course pixel (i, j) has centre (0, i*0.0025 - 0.99875, j*0.0025 - 0.99875);
+        // the written column is 799 - i and the row is 799 - j.
+        for (i, j) in [(0u32, 0u32), (799, 799), (123, 456)] {
+            let r = cam.ray(799 - i, 799 - j, Vec2::splat(0.5));
+            let t = (0.0 - r.origin.x) / r.dir.x;
+            let p = r.at(t);
+            let want = Vec3::new(
+                0.0,
+                i as f32 * 0.0025 - 0.99875,
+                j as f32 * 0.0025 - 0.99875,
+            );
+            assert!((p - want).length() < 1e-5, "{p} vs {want}");
+        }
+        // Field of view: the top edge's centre seen from e1 at 2*atan(1/2).
+        let top = cam.ray(400, 0, Vec2::new(0.0, 0.0));
+        let bottom = cam.ray(400, 799, Vec2::new(0.0, 1.0));
+        let fov = top.dir.angle_between(bottom.dir).to_degrees();
+        assert!((fov - 53.130).abs() < 0.01, "{fov}");
+        let cam2 = Scene::tncg15(Eye::Two).camera;
+        let fov2 = cam2
+            .ray(400, 0, Vec2::ZERO)
+            .dir
+            .angle_between(cam2.ray(400, 799, Vec2::new(0.0, 1.0)).dir);
+        assert!((fov2.to_degrees() - 90.0).abs() < 0.01);
+    }
+}

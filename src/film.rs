@@ -1,0 +1,69 @@
+//! The film: linear radiance per pixel, row 0 at the top; and the course's
+//! ways of turning it into 8-bit values.
+
+use crate::math::Color;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<Color>,
+}
+
+/// How radiance becomes an 8-bit value (TNCG15 lecture 6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum ToneMap {
+    /// v * 255.99 / i_max, i_max the largest channel value in the image.
+    #[default]
+    Linear,
+    /// sqrt(v) * 255.99 / sqrt(i_max): for scenes with bright spots.
+    Sqrt,
+}
+
+impl Film {
+    pub fn new(width: u32, height: u32) -> Self {
+        Film {
+            width,
+            height,
+            pixels: vec![Color::ZERO; width as usize * height as usize],
+        }
+    }
+
+    pub fn get(&self, col: u32, row: u32) -> Color {
+        self.pixels[row as usize * self.width as usize + col as usize]
+    }
+
+    /// Mean of all pixels and channels.
+    pub fn mean(&self) -> f64 {
+        self.pixels
+            .iter()
+            .map(|c| (c.x + c.y + c.z) as f64)
+            .sum::<f64>()
+            / (3 * self.pixels.len()).max(1) as f64
+    }
+
+    /// 8-bit RGB, row-major: radiance times `exposure`, mapped by `tonemap`
+    /// against the image's largest value, truncated as the course does, and
+    /// clamped to [0, 255].
+    pub fn to_rgb8(&self, tonemap: ToneMap, exposure: f32) -> Vec<u8> {
+        let curve = |v: f32| match tonemap {
+            ToneMap::Linear => v.max(0.0),
+            ToneMap::Sqrt => v.max(0.0).sqrt(),
+        };
+        let i_max = self
+            .pixels
+            .iter()
+            .fold(0.0f32, |m, c| m.max(c.max_element()))
+            * exposure.max(0.0);
+        let scale = if i_max > 0.0 {
+            255.99 / curve(i_max)
+        } else {
+            0.0
+        };
+        self.pixels
+            .iter()
+            .flat_map(|c| (*c * exposure).to_array())
+            .map(|v| (curve(v) * scale).clamp(0.0, 255.0) as u8)
+            .collect()
+    }
+}

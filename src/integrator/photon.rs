@@ -1,0 +1,299 @@
+//! The photon-mapping camera pass (Jensen 1996, 2001).
+//!
+//! A camera ray follows mirrors and glass until it meets a diffuse surface at
+//! x (or a light, whose radiance it takes). There the radiance towards the
+//! camera is split by the light path that brought it, each path counted by
+//! exactly one estimator (notes/method.md):
+//!
+//! | light path into x        | estimator                                      |
+//! |--------------------------|------------------------------------------------|
+//! | light → x                | direct: shadow rays to the lights              |
+//! | light → specular+ → x    | caustic map, cone-filtered k-nearest estimate  |
+//! | light → … diffuse → x    | final gathering: cosine rays from x, through   |
+//! |                          | any specular chain, to a diffuse y, reading    |
+//! |                          | the global map's irradiance precomputed near y |
+//!
+//! Gather rays that reach a light (directly or through mirrors and glass)
+//! add nothing: those paths belong to the first two rows.
+
+use super::Tally;
+use crate::material::Material;
+use crate::math::{max_component, Color, Frame, Ray};
+use crate::optics::{fresnel_dielectric, reflect, refract};
+use crate::photon::map::{IrradianceCache, PhotonMap, Scratch};
+use crate::sampling::{cosine_hemisphere, next_2d, stratified_2d, Rng};
+use crate::scene::{Hit, Scene};
+use crate::shape::Departure;
+use rand::RngExt;
+use std::f32::consts::PI;
+
+/// Camera paths split into both the reflected and refracted branch at their
+/// first glass vertices (no noise from the choice where it matters most);
+/// deeper, Fresnel picks one branch.
+const SPLIT_DEPTH: u32 = 2;
+/// Specular chains are cut after this many bounces (light trapped by total
+/// internal reflection; its share is negligible).
+const MAX_SPECULAR_DEPTH: u32 = 24;
+
+/// Quality settings of the estimator.
+#[derive(Clone, Copy, Debug)]
+pub struct PhotonEstimator {
+    /// Nearest caustic photons per estimate, and the search radius cap.
+    pub k_caustic: usize,
+    pub r_caustic: f32,
+    /// Final-gather rays per diffuse camera hit.
+    pub gather_rays: u32,
+    /// Shadow rays per light per diffuse camera hit.
+    pub shadow_rays: u32,
+}
+
+pub struct PhotonIntegrator<'a> {
+    pub scene: &'a Scene,
+    pub caustic: &'a PhotonMap,
+    pub cache: &'a IrradianceCache,
+    pub settings: PhotonEstimator,
+}
+
+/// Which part of the radiance a camera sample estimates. A pixel's value is
+/// the sum of what reaches the eye from a light's own surface (directly or
+/// through mirrors and glass) and what diffuse surfaces send; the two can be
+/// estimated with different numbers of samples, because the first is cheap
+/// and, at the rim of a light's image, has most of the variance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part {
+    All,
+    /// Emitted radiance seen along specular chains only (diffuse hits are dark).
+    Emitted,
+    /// Radiance from diffuse surfaces only (light surfaces are dark).
+    Reflected,
+}
+
+/// Per-thread state: random stream, scratch for lookups, counters.
+pub struct Context<'r> {
+    pub rng: &'r mut Rng,
+    pub scratch: &'r mut Scratch,
+    pub tally: &'r mut Tally,
+    pub pixel: u64,
+}
+
+impl PhotonIntegrator<'_> {
+    /// Radiance arriving along a camera ray (towards its origin).
+    pub fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context) -> Color {
+        self.trace(ray, None, 0, part, ctx)
+    }
+
+    fn trace(
+        &self,
+        ray: Ray,
+        departure: Option<Departure>,
+        depth: u32,
+        part: Part,
+        ctx: &mut Context,
+    ) -> Color {
+        ctx.tally.rays += 1;
+        let Some(hit) = self.scene.intersect(&ray, departure) else {
+            return Color::ZERO;
+        };
+        match *self.scene.material(hit.prim) {
+            Material::Emitter if part == Part::Reflected => Color::ZERO,
+            Material::Emitter => self
+                .scene
+                .light_of(hit.prim)
+                .map_or(Color::ZERO, |l| l.radiance_towards(ray.dir)),
+            Material::Lambertian { rho } => {
+                if max_component(rho) <= 0.0 || part == Part::Emitted {
+                    return Color::ZERO;
+                }
+                let n = hit.facing_normal(ray.dir);
+                let direct = self.direct(&hit, n, rho, ctx);
+                let caustic = self.caustic(&hit, n, rho, ctx);
+                let indirect = self.indirect(&hit, n, rho, ctx);
+                self.checked(direct, "direct", ctx)
+                    + self.checked(caustic, "caustic", ctx)
+                    + self.checked(indirect, "indirect", ctx)
+            }
+            Material::Mirror { reflectance } => {
+                if depth >= MAX_SPECULAR_DEPTH || max_component(reflectance) <= 0.0 {
+                    return Color::ZERO;
+                }
+                let frame = Frame::from_normal(hit.facing_normal(ray.dir));
+                let wo = frame
+                    .to_world(reflect(frame.to_local(-ray.dir)))
+                    .normalize();
+                let (next, dep) = hit.spawn(wo);
+                reflectance * self.trace(next, Some(dep), depth + 1, part, ctx)
+            }
+            Material::Glass { ior } => {
+                if depth >= MAX_SPECULAR_DEPTH {
+                    return Color::ZERO;
+                }
+                let branches = glass_branches(&hit, &ray, ior);
+                let reflected = |s: &Self, ctx: &mut Context| {
+                    let (next, dep) = hit.spawn(branches.reflected);
+                    s.trace(next, Some(dep), depth + 1, part, ctx)
+                };
+                match branches.refracted {
+                    None => reflected(self, ctx),
+                    Some((wt, radiance_scale)) => {
+                        let refracted = |s: &Self, ctx: &mut Context| {
+                            let (next, dep) = hit.spawn(wt);
+                            radiance_scale * s.trace(next, Some(dep), depth + 1, part, ctx)
+                        };
+                        let r = branches.fresnel;
+                        if depth < SPLIT_DEPTH {
+                            r * reflected(self, ctx) + (1.0 - r) * refracted(self, ctx)
+                        } else if ctx.rng.random::<f32>() < r {
+                            reflected(self, ctx)
+                        } else {
+                            refracted(self, ctx)
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Light → x: area-sampled shadow rays to every light.
+    fn direct(&self, hit: &Hit, n: glam::Vec3, rho: Color, ctx: &mut Context) -> Color {
+        let mut sum = Color::ZERO;
+        let count = self.settings.shadow_rays;
+        for light in &self.scene.lights {
+            let mut light_sum = Color::ZERO;
+            for s in 0..count {
+                let sample = light.sample_point(stratified_2d(s, count, next_2d(ctx.rng)));
+                let to_light = sample.point - hit.point;
+                let dist2 = to_light.length_squared();
+                if !(dist2 > 0.0) {
+                    continue;
+                }
+                let dist = dist2.sqrt();
+                let w = to_light / dist;
+                let cos_x = n.dot(w);
+                let cos_l = -w.dot(sample.normal);
+                if cos_x <= 0.0 || cos_l <= 0.0 {
+                    continue;
+                }
+                let (shadow, dep) = hit.spawn(w);
+                ctx.tally.rays += 1;
+                let t_max = (sample.point - shadow.origin).length();
+                if self
+                    .scene
+                    .occluded(&shadow, Some(dep), t_max, Some(light.prim))
+                {
+                    continue;
+                }
+                light_sum += light.radiance * (cos_x * cos_l / (dist2 * sample.pdf_area));
+            }
+            sum += light_sum / count.max(1) as f32;
+        }
+        rho / PI * sum
+    }
+
+    /// Light → specular+ → x: the caustic map.
+    fn caustic(&self, hit: &Hit, n: glam::Vec3, rho: Color, ctx: &mut Context) -> Color {
+        if self.caustic.is_empty() {
+            return Color::ZERO;
+        }
+        self.caustic.radiance_cone(
+            hit.point,
+            n,
+            rho,
+            self.settings.k_caustic,
+            self.settings.r_caustic,
+            ctx.scratch,
+        )
+    }
+
+    /// Light → … diffuse y → (specular*) → x: final gathering.
+    fn indirect(&self, hit: &Hit, n: glam::Vec3, rho: Color, ctx: &mut Context) -> Color {
+        let count = self.settings.gather_rays;
+        if count == 0 || self.cache.is_empty() {
+            return Color::ZERO;
+        }
+        let frame = Frame::from_normal(n);
+        let mut sum = Color::ZERO;
+        for g in 0..count {
+            let dir = frame
+                .to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(ctx.rng))))
+                .normalize();
+            let (mut ray, mut dep) = hit.spawn(dir);
+            let mut weight = Color::ONE;
+            for _ in 0..MAX_SPECULAR_DEPTH {
+                ctx.tally.rays += 1;
+                let Some(y) = self.scene.intersect(&ray, Some(dep)) else {
+                    break;
+                };
+                let next_dir = match *self.scene.material(y.prim) {
+                    Material::Lambertian { rho: rho_y } => {
+                        let n_y = y.facing_normal(ray.dir);
+                        let e = self.cache.lookup(y.point, n_y, ctx.scratch);
+                        sum += weight * rho_y / PI * e;
+                        break;
+                    }
+                    Material::Emitter => break,
+                    Material::Mirror { reflectance } => {
+                        weight *= reflectance;
+                        let f = Frame::from_normal(y.facing_normal(ray.dir));
+                        f.to_world(reflect(f.to_local(-ray.dir)))
+                    }
+                    Material::Glass { ior } => {
+                        let b = glass_branches(&y, &ray, ior);
+                        match b.refracted {
+                            Some((wt, scale)) if ctx.rng.random::<f32>() >= b.fresnel => {
+                                weight *= scale;
+                                wt
+                            }
+                            _ => b.reflected,
+                        }
+                    }
+                };
+                (ray, dep) = y.spawn(next_dir.normalize());
+            }
+        }
+        // Cosine-weighted directions: f cos / pdf = (rho / pi) cos / (cos / pi) = rho.
+        rho * sum / count as f32
+    }
+
+    fn checked(&self, c: Color, estimator: &'static str, ctx: &mut Context) -> Color {
+        debug_assert!(
+            c.is_finite(),
+            "{estimator} estimate {c} at pixel {}",
+            ctx.pixel
+        );
+        if c.is_finite() {
+            c
+        } else {
+            ctx.tally.nonfinite += 1;
+            ctx.tally
+                .first_nonfinite
+                .get_or_insert((ctx.pixel, estimator));
+            Color::ZERO
+        }
+    }
+}
+
+/// The two directions leaving a smooth dielectric, computed in the local
+/// frame of the surface.
+pub struct GlassBranches {
+    pub fresnel: f32,
+    pub reflected: glam::Vec3,
+    /// Refracted direction and the radiance scale (n_i / n_t)^2 of a camera
+    /// path crossing into the other medium; `None` on total internal reflection.
+    pub refracted: Option<(glam::Vec3, f32)>,
+}
+
+pub fn glass_branches(hit: &Hit, ray: &Ray, ior: f32) -> GlassBranches {
+    let frame = Frame::from_normal(hit.facing_normal(ray.dir));
+    let wi = frame.to_local(-ray.dir);
+    let entering = ray.dir.dot(hit.normal) < 0.0;
+    let (n_i, n_t) = if entering { (1.0, ior) } else { (ior, 1.0) };
+    let fresnel = fresnel_dielectric(wi.z, n_i, n_t);
+    let reflected = frame.to_world(reflect(wi)).normalize();
+    let refracted =
+        refract(wi, n_i / n_t).map(|wt| (frame.to_world(wt).normalize(), (n_i / n_t).powi(2)));
+    GlassBranches {
+        fresnel: if refracted.is_some() { fresnel } else { 1.0 },
+        reflected,
+        refracted,
+    }
+}

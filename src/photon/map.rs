@@ -1,0 +1,410 @@
+//! Photon maps: kd-trees over photon positions (kiddo; the only module that
+//! names it) and the density estimates read from them.
+//!
+//! Positions go into the tree rotated by a fixed generic rotation: photons
+//! on axis-aligned walls share one coordinate exactly, which makes kd-tree
+//! splits degenerate and queries slow (shared/research/ecosystem.md §2);
+//! distances are unchanged by a rotation. Photons are stored in Morton order
+//! so that neighbours in space are neighbours in memory.
+
+use super::{oct_decode, oct_encode, Photon};
+use crate::math::Color;
+use glam::{EulerRot, Mat3, Vec3};
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use rayon::prelude::*;
+use std::f32::consts::PI;
+
+/// Photons whose stored normal is further than this (cosine) from the query
+/// normal lie on another surface (the wall in a corner, the far side of a
+/// thin object) and are left out of the estimate.
+const NORMAL_COSINE: f32 = 0.9;
+
+/// Scratch space a thread reuses for every query (no allocation per lookup),
+/// with the squared radius its last k-nearest search needed: neighbouring
+/// queries need similar radii, so the next search starts there.
+#[derive(Default, Debug)]
+pub struct Scratch {
+    buf: Vec<(f32, u32)>,
+    hint_r2: f32,
+}
+
+fn rotation() -> Mat3 {
+    Mat3::from_euler(EulerRot::XYZ, 0.61, 0.93, 0.37)
+}
+
+/// A kd-tree over points, with the rotation applied on the way in.
+struct PointTree {
+    tree: Option<ImmutableKdTree<f32, 3>>,
+    rot: Mat3,
+}
+
+impl PointTree {
+    fn build(points: impl IndexedParallelIterator<Item = Vec3>) -> Self {
+        let rot = rotation();
+        let pts: Vec<[f32; 3]> = points.map(|p| (rot * p).to_array()).collect();
+        // An empty map has no tree; queries on it find nothing.
+        let tree = if pts.is_empty() {
+            None
+        } else {
+            ImmutableKdTree::new_from_slice(&pts).ok()
+        };
+        PointTree { tree, rot }
+    }
+
+    /// (squared distance, index) of the nearest point, if any.
+    fn nearest(&self, x: Vec3) -> Option<(f32, u32)> {
+        self.tree.as_ref().map(|tree| {
+            let n = tree
+                .query(&(self.rot * x).to_array())
+                .nearest_one::<SquaredEuclidean<f32>>()
+                .execute();
+            (n.distance, n.item)
+        })
+    }
+
+    /// Pushes (squared distance, index) of every point within sqrt(r2) of x.
+    fn within(&self, x: Vec3, r2: f32, buf: &mut Vec<(f32, u32)>) {
+        if let Some(tree) = &self.tree {
+            tree.query(&(self.rot * x).to_array())
+                .within::<SquaredEuclidean<f32>>(r2)
+                .unsorted()
+                .visit(|n| buf.push((n.distance, n.item)));
+        }
+    }
+}
+
+/// Sorts photons along a Morton curve over their bounds (stable, so the
+/// order is deterministic).
+fn morton_sort(photons: &mut [Photon]) {
+    let (lo, hi) = photons.iter().fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(lo, hi), p| (lo.min(p.position()), hi.max(p.position())),
+    );
+    let scale = 1023.0 / (hi - lo).max(Vec3::splat(f32::MIN_POSITIVE));
+    let spread = |mut v: u32| {
+        v &= 0x3FF;
+        v = (v | (v << 16)) & 0x0300_00FF;
+        v = (v | (v << 8)) & 0x0300_F00F;
+        v = (v | (v << 4)) & 0x030C_30C3;
+        (v | (v << 2)) & 0x0924_9249
+    };
+    photons.par_sort_by_key(|p| {
+        let q = ((p.position() - lo) * scale).as_uvec3();
+        spread(q.x) | (spread(q.y) << 1) | (spread(q.z) << 2)
+    });
+}
+
+/// A photon map: the photons and a kd-tree over their positions.
+pub struct PhotonMap {
+    photons: Vec<Photon>,
+    tree: PointTree,
+}
+
+/// The photons found for one estimate.
+pub struct Gathered {
+    /// Squared radius of the disk the estimate divides by.
+    pub r2: f32,
+    pub count: usize,
+}
+
+impl PhotonMap {
+    pub fn build(mut photons: Vec<Photon>) -> Self {
+        morton_sort(&mut photons);
+        let tree = PointTree::build(photons.par_iter().map(|p| p.position()));
+        PhotonMap { photons, tree }
+    }
+
+    pub fn len(&self) -> usize {
+        self.photons.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.photons.is_empty()
+    }
+
+    pub fn photons(&self) -> &[Photon] {
+        &self.photons
+    }
+
+    /// Bytes held by the photons and the tree (an estimate of the tree part:
+    /// kiddo stores one f32 triple and one u32 per point, plus its stems).
+    pub fn memory_bytes(&self) -> usize {
+        self.photons.len() * (std::mem::size_of::<Photon>() + 16)
+    }
+
+    /// Finds the `k` nearest photons within `r_max` of `x` (fewer if fewer are
+    /// there) and keeps in the scratch those on a surface facing like `n`.
+    /// The estimate's disk has the k-th photon on its rim, or radius `r_max`
+    /// when fewer than `k` were found (a fixed-radius estimate). Photons on
+    /// other surfaces (a wall in a corner) take part in fixing the radius but
+    /// add no flux: the disk is the surface's own.
+    pub fn gather(
+        &self,
+        x: Vec3,
+        n: Vec3,
+        k: usize,
+        r_max: f32,
+        scratch: &mut Scratch,
+    ) -> Gathered {
+        let r_max2 = r_max * r_max;
+        let buf = &mut scratch.buf;
+        // Search a growing radius from the hint: the result is the same as one
+        // search at r_max, at the cost of the photons near the answer only.
+        let mut r2 = if scratch.hint_r2 > 0.0 {
+            scratch.hint_r2.min(r_max2)
+        } else {
+            r_max2 * 1e-4
+        };
+        loop {
+            buf.clear();
+            self.tree.within(x, r2, buf);
+            if buf.len() >= k || r2 >= r_max2 {
+                break;
+            }
+            r2 = (r2 * 4.0).min(r_max2);
+        }
+        let r2 = if k > 0 && buf.len() >= k {
+            buf.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
+            buf.truncate(k);
+            buf[k - 1].0
+        } else {
+            r_max2
+        };
+        scratch.hint_r2 = if r2 < r_max2 { r2 * 1.5 } else { r_max2 };
+        buf.retain(|&(_, i)| self.photons[i as usize].surface_normal().dot(n) >= NORMAL_COSINE);
+        Gathered {
+            r2,
+            count: buf.len(),
+        }
+    }
+
+    /// Irradiance at `x` with a box kernel: sum of flux / (pi r^2).
+    pub fn irradiance(
+        &self,
+        x: Vec3,
+        n: Vec3,
+        k: usize,
+        r_max: f32,
+        buf: &mut Scratch,
+    ) -> (Color, f32) {
+        let g = self.gather(x, n, k, r_max, buf);
+        if g.count == 0 || !(g.r2 > 0.0) {
+            return (Color::ZERO, g.r2);
+        }
+        let flux: Color = buf
+            .buf
+            .iter()
+            .map(|&(_, i)| self.photons[i as usize].flux())
+            .sum();
+        (flux / (PI * g.r2), g.r2)
+    }
+
+    /// Radiance reflected by a Lambertian surface of reflectance `rho`,
+    /// estimated with Jensen's cone filter (k = 1: weight 1 - d / r,
+    /// normalised by 1 / (1 - 2/3)), which keeps caustic edges sharp.
+    pub fn radiance_cone(
+        &self,
+        x: Vec3,
+        n: Vec3,
+        rho: Color,
+        k: usize,
+        r_max: f32,
+        buf: &mut Scratch,
+    ) -> Color {
+        let g = self.gather(x, n, k, r_max, buf);
+        if g.count == 0 || !(g.r2 > 0.0) {
+            return Color::ZERO;
+        }
+        let r = g.r2.sqrt();
+        let flux: Color = buf
+            .buf
+            .iter()
+            .map(|&(d2, i)| self.photons[i as usize].flux() * (1.0 - d2.sqrt() / r).max(0.0))
+            .sum();
+        rho / PI * flux * 3.0 / (PI * g.r2)
+    }
+}
+
+/// Irradiance precomputed at a subset of the global photons (Christensen
+/// 1999): final-gather rays then read one nearby value instead of running a
+/// k-nearest estimate each.
+pub struct IrradianceCache {
+    points: Vec<CachePoint>,
+    tree: PointTree,
+    /// Squared search radius of a lookup.
+    lookup_r2: f32,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct CachePoint {
+    irradiance: [f32; 3],
+    normal: u32,
+}
+
+impl IrradianceCache {
+    /// Precomputes irradiance at every `stride`-th photon of `map` from its
+    /// `k` nearest within `r_max`.
+    pub fn build(map: &PhotonMap, stride: usize, k: usize, r_max: f32) -> Self {
+        let stride = stride.max(1);
+        let computed: Vec<(Vec3, CachePoint, f32)> = map
+            .photons
+            .par_iter()
+            .step_by(stride)
+            .map_init(Scratch::default, |buf, p| {
+                let n = p.surface_normal();
+                let (e, r2) = map.irradiance(p.position(), n, k, r_max, buf);
+                (
+                    p.position(),
+                    CachePoint {
+                        irradiance: e.to_array(),
+                        normal: oct_encode(n),
+                    },
+                    r2,
+                )
+            })
+            .collect();
+        // Search as far as twice the median estimate radius: far enough to
+        // find a cached point on the same surface almost everywhere, near
+        // enough to stay within the blur the estimates already have.
+        let mut radii: Vec<f32> = computed.iter().map(|c| c.2).collect();
+        let lookup_r2 = if radii.is_empty() {
+            0.0
+        } else {
+            let mid = radii.len() / 2;
+            let median = *radii.select_nth_unstable_by(mid, f32::total_cmp).1;
+            (4.0 * median).min(r_max * r_max)
+        };
+        let tree = PointTree::build(computed.par_iter().map(|c| c.0));
+        IrradianceCache {
+            points: computed.into_iter().map(|c| c.1).collect(),
+            tree,
+            lookup_r2,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// Irradiance of the nearest cached point on a surface facing like `n`;
+    /// zero where no photon came near.
+    pub fn lookup(&self, x: Vec3, n: Vec3, scratch: &mut Scratch) -> Color {
+        // Almost always the nearest point is on the same surface; only near
+        // edges and corners is a wider search needed.
+        match self.tree.nearest(x) {
+            None => return Color::ZERO,
+            Some((d2, i))
+                if d2 <= self.lookup_r2
+                    && oct_decode(self.points[i as usize].normal).dot(n) >= NORMAL_COSINE =>
+            {
+                return Vec3::from(self.points[i as usize].irradiance);
+            }
+            _ => {}
+        }
+        let buf = &mut scratch.buf;
+        buf.clear();
+        self.tree.within(x, self.lookup_r2, buf);
+        let mut best: Option<(f32, u32)> = None;
+        for &(d2, i) in buf.iter() {
+            if best.is_none_or(|b| d2 < b.0)
+                && oct_decode(self.points[i as usize].normal).dot(n) >= NORMAL_COSINE
+            {
+                best = Some((d2, i));
+            }
+        }
+        best.map_or(Color::ZERO, |(_, i)| {
+            Vec3::from(self.points[i as usize].irradiance)
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::{next_2d, stream, Domain};
+
+    /// Photons of equal power spread uniformly over a square: the estimates
+    /// must return the known irradiance (and radiance rho/pi * E).
+    #[test]
+    fn estimates_recover_a_uniform_photon_density() {
+        let mut rng = stream(11, Domain::Camera, 0);
+        let (side, n) = (10.0f32, 400_000usize);
+        let power = 2.0f32;
+        let photons: Vec<Photon> = (0..n)
+            .map(|_| {
+                let u = next_2d(&mut rng) * side;
+                Photon::new(
+                    Vec3::new(u.x, u.y, 0.0),
+                    Color::splat(power),
+                    Vec3::Z,
+                    Vec3::Z,
+                )
+            })
+            .collect();
+        let map = PhotonMap::build(photons);
+        let exact = power * n as f32 / (side * side);
+        let mut buf = Scratch::default();
+        let mut box_sum = 0.0;
+        let mut cone_sum = 0.0;
+        let queries = 400;
+        for q in 0..queries {
+            let x = Vec3::new(
+                2.0 + 6.0 * (q % 20) as f32 / 20.0,
+                2.0 + 6.0 * (q / 20) as f32 / 20.0,
+                0.0,
+            );
+            box_sum += map.irradiance(x, Vec3::Z, 200, 1.0, &mut buf).0.x;
+            cone_sum += map
+                .radiance_cone(x, Vec3::Z, Color::splat(PI), 200, 1.0, &mut buf)
+                .x;
+        }
+        let (box_mean, cone_mean) = (box_sum / queries as f32, cone_sum / queries as f32);
+        // k-NN with the k-th photon on the rim overestimates by k / (k - 1);
+        // both means must be within 1.5% of the truth.
+        assert!(
+            (box_mean / exact - 1.0).abs() < 0.015,
+            "box {box_mean} vs {exact}"
+        );
+        assert!(
+            (cone_mean / exact - 1.0).abs() < 0.015,
+            "cone {cone_mean} vs {exact}"
+        );
+        // Photons facing away (other surface) are ignored.
+        assert_eq!(
+            map.irradiance(Vec3::new(5.0, 5.0, 0.0), -Vec3::Z, 50, 1.0, &mut buf)
+                .0,
+            Color::ZERO
+        );
+        // An empty map answers zero.
+        let empty = PhotonMap::build(Vec::new());
+        assert_eq!(
+            empty.irradiance(Vec3::ZERO, Vec3::Z, 10, 1.0, &mut buf).0,
+            Color::ZERO
+        );
+    }
+
+    #[test]
+    fn irradiance_cache_agrees_with_direct_estimate() {
+        let mut rng = stream(12, Domain::Camera, 0);
+        let photons: Vec<Photon> = (0..100_000)
+            .map(|_| {
+                let u = next_2d(&mut rng) * 4.0;
+                Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y, Vec3::Y)
+            })
+            .collect();
+        let map = PhotonMap::build(photons);
+        let cache = IrradianceCache::build(&map, 4, 100, 1.0);
+        assert_eq!(cache.len(), 25_000);
+        let mut buf = Scratch::default();
+        let x = Vec3::new(2.0, 0.0, 2.0);
+        let direct = map.irradiance(x, Vec3::Y, 100, 1.0, &mut buf).0.x;
+        let cached = cache.lookup(x, Vec3::Y, &mut buf).x;
+        assert!((cached / direct - 1.0).abs() < 0.25, "{cached} {direct}");
+        assert!((direct / 6250.0 - 1.0).abs() < 0.2, "{direct}");
+        assert_eq!(cache.lookup(x, -Vec3::Y, &mut buf), Color::ZERO);
+    }
+}

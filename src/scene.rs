@@ -1,0 +1,301 @@
+//! The scene: primitives with materials, lights, the camera, and what the
+//! renderer derives from them once (bounds, the specular objects photons are
+//! aimed at). [`Scene::tncg15`] builds the built-in default scene, the TNCG15
+//! hexagonal room of `notes/default-scene.md`, number for number.
+
+use crate::accel::Accel;
+use crate::camera::Camera;
+use crate::light::DiskLight;
+use crate::material::Material;
+use crate::math::{offset_ray_origin, Color, Ray, Vertex};
+use crate::shape::{tetrahedron, Departure, Disk, Shape, Sphere, Triangle};
+use glam::{Vec2, Vec3};
+
+/// One primitive: its geometry and the index of its material.
+#[derive(Clone, Copy, Debug)]
+pub struct Prim {
+    pub shape: Shape,
+    pub material: u32,
+}
+
+/// A ray's nearest intersection with the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct Hit {
+    pub t: f32,
+    pub point: Vertex,
+    pub p_err: Vec3,
+    /// Geometric normal as the shape defines it.
+    pub normal: Vec3,
+    pub prim: u32,
+}
+
+impl Hit {
+    /// The geometric normal turned to the side the ray `dir` arrived from.
+    pub fn facing_normal(&self, dir: Vec3) -> Vec3 {
+        if self.normal.dot(dir) < 0.0 {
+            self.normal
+        } else {
+            -self.normal
+        }
+    }
+
+    /// A ray leaving this hit along unit `dir`, with its departure record.
+    pub fn spawn(&self, dir: Vec3) -> (Ray, Departure) {
+        let origin = offset_ray_origin(self.point, self.p_err, self.normal, dir);
+        (
+            Ray::new(origin, dir),
+            Departure {
+                prim: self.prim,
+                outward: dir.dot(self.normal) > 0.0,
+            },
+        )
+    }
+}
+
+/// A bounding sphere of a specular object, for aiming caustic photons.
+#[derive(Clone, Copy, Debug)]
+pub struct Target {
+    pub center: Vertex,
+    pub radius: f32,
+}
+
+pub struct Scene {
+    pub prims: Vec<Prim>,
+    pub materials: Vec<Material>,
+    pub lights: Vec<DiskLight>,
+    pub camera: Camera,
+    /// Light index per primitive (`None` for non-emitters).
+    light_of_prim: Vec<Option<u32>>,
+    accel: Accel,
+    bounds: (Vec3, Vec3),
+    targets: Vec<Target>,
+}
+
+/// The eye positions of the course's camera.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Eye {
+    /// e1 = (-2, 0, 0): 53.13 degree view (the default).
+    One,
+    /// e2 = (-1, 0, 0): 90 degree view.
+    Two,
+}
+
+impl Scene {
+    /// Assembles a scene; the disk lights are added as primitives too, so that
+    /// camera rays see them and photons are absorbed by them.
+    pub fn new(
+        mut prims: Vec<Prim>,
+        mut materials: Vec<Material>,
+        lights: Vec<(Disk, Color)>,
+        camera: Camera,
+    ) -> Self {
+        let mut light_of_prim = vec![None; prims.len()];
+        let mut disk_lights = Vec::new();
+        if !lights.is_empty() {
+            materials.push(Material::Emitter);
+        }
+        let emitter = materials.len() as u32 - 1;
+        for (disk, radiance) in lights {
+            let prim = prims.len() as u32;
+            prims.push(Prim {
+                shape: Shape::Disk(disk),
+                material: emitter,
+            });
+            light_of_prim.push(Some(disk_lights.len() as u32));
+            disk_lights.push(DiskLight::new(disk, radiance, prim));
+        }
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for p in &prims {
+            let (a, b) = p.shape.bounds();
+            lo = lo.min(a);
+            hi = hi.max(b);
+        }
+        let targets = prims
+            .iter()
+            .filter(|p| materials[p.material as usize].is_specular())
+            .map(|p| {
+                let (center, radius) = p.shape.bounding_sphere();
+                Target { center, radius }
+            })
+            .collect();
+        let accel = Accel::new(prims.iter().map(|p| p.shape).collect());
+        Scene {
+            prims,
+            materials,
+            lights: disk_lights,
+            camera,
+            light_of_prim,
+            accel,
+            bounds: (lo, hi),
+            targets,
+        }
+    }
+
+    /// The built-in TNCG15 room (see notes/default-scene.md), 800 x 800.
+    pub fn tncg15(eye: Eye) -> Self {
+        let hexagon = [
+            Vec2::new(-3.0, 0.0),
+            Vec2::new(0.0, 6.0),
+            Vec2::new(10.0, 6.0),
+            Vec2::new(13.0, 0.0),
+            Vec2::new(10.0, -6.0),
+            Vec2::new(0.0, -6.0),
+        ];
+        let (floor_z, ceiling_z) = (-5.0, 5.0);
+        let grey = Color::splat(0.8);
+        let wall_rho = [
+            Color::new(0.80, 0.10, 0.80), // P0-P1 back-left, magenta
+            Color::new(0.80, 0.10, 0.10), // P1-P2 left, red
+            Color::new(0.80, 0.80, 0.10), // P2-P3 front-left, yellow
+            Color::new(0.10, 0.30, 0.80), // P3-P4 front-right, blue
+            Color::new(0.10, 0.80, 0.10), // P4-P5 right, green
+            Color::new(0.10, 0.80, 0.80), // P5-P0 back-right, cyan
+        ];
+        let mut materials = vec![Material::Lambertian { rho: grey }];
+        let mut prims = Vec::new();
+        let inside = Vec3::new(5.0, 0.0, 0.0);
+        // Wind each room triangle so its normal points into the room.
+        let mut room_triangle = |a: Vec3, b: Vec3, c: Vec3, material: u32| {
+            let t = Triangle::new(a, b, c);
+            let t = if t.normal.dot(inside - a) < 0.0 {
+                Triangle::new(a, c, b)
+            } else {
+                t
+            };
+            prims.push(Prim {
+                shape: Shape::Triangle(t),
+                material,
+            });
+        };
+        // Floor and ceiling: a fan of six triangles around the hexagon's centre.
+        let centre = Vec2::new(5.0, 0.0);
+        for z in [floor_z, ceiling_z] {
+            for i in 0..6 {
+                let (a, b) = (hexagon[i], hexagon[(i + 1) % 6]);
+                room_triangle(centre.extend(z), a.extend(z), b.extend(z), 0);
+            }
+        }
+        for (i, rho) in wall_rho.iter().enumerate() {
+            materials.push(Material::Lambertian { rho: *rho });
+            let m = materials.len() as u32 - 1;
+            let (a, b) = (hexagon[i], hexagon[(i + 1) % 6]);
+            room_triangle(a.extend(floor_z), b.extend(floor_z), b.extend(ceiling_z), m);
+            room_triangle(
+                a.extend(floor_z),
+                b.extend(ceiling_z),
+                a.extend(ceiling_z),
+                m,
+            );
+        }
+        materials.push(Material::Glass { ior: 1.5 });
+        let glass = materials.len() as u32 - 1;
+        prims.push(Prim {
+            shape: Shape::Sphere(Sphere {
+                center: Vec3::new(9.5, -2.0, -3.0),
+                radius: 1.5,
+            }),
+            material: glass,
+        });
+        materials.push(Material::Mirror {
+            reflectance: Color::splat(0.95),
+        });
+        let mirror = materials.len() as u32 - 1;
+        prims.push(Prim {
+            shape: Shape::Sphere(Sphere {
+                center: Vec3::new(10.0, 2.5, -3.6),
+                radius: 1.4,
+            }),
+            material: mirror,
+        });
+        materials.push(Material::Lambertian {
+            rho: Color::new(0.9, 0.6, 0.1),
+        });
+        let tet = materials.len() as u32 - 1;
+        for t in tetrahedron(
+            Vec3::new(10.8, -1.0, -5.0),
+            Vec3::new(10.8, 1.0, -5.0),
+            Vec3::new(12.4, 0.0, -5.0),
+            Vec3::new(11.3, 0.0, -2.5),
+        ) {
+            prims.push(Prim {
+                shape: Shape::Triangle(t),
+                material: tet,
+            });
+        }
+        let light = Disk {
+            center: Vec3::new(8.0, 0.0, 4.999),
+            normal: -Vec3::Z,
+            radius: 1.0,
+        };
+        let eye_point = match eye {
+            Eye::One => Vec3::new(-2.0, 0.0, 0.0),
+            Eye::Two => Vec3::new(-1.0, 0.0, 0.0),
+        };
+        let camera = Camera::from_corners(
+            eye_point,
+            // The image plane x = 0; seen from the eye, +y is left and +z up.
+            [
+                Vec3::new(0.0, -1.0, -1.0),
+                Vec3::new(0.0, 1.0, -1.0),
+                Vec3::new(0.0, 1.0, 1.0),
+                Vec3::new(0.0, -1.0, 1.0),
+            ],
+            800,
+            800,
+        );
+        Scene::new(prims, materials, vec![(light, Color::splat(10.0))], camera)
+    }
+
+    pub fn intersect(&self, ray: &Ray, departure: Option<Departure>) -> Option<Hit> {
+        self.accel
+            .closest_hit(ray, departure, f32::INFINITY)
+            .map(|(prim, h)| Hit {
+                t: h.t,
+                point: h.point,
+                p_err: h.p_err,
+                normal: h.normal,
+                prim,
+            })
+    }
+
+    /// Whether the segment from the ray's origin to `t_max` is blocked by
+    /// anything but primitive `ignore` (the light being aimed at).
+    pub fn occluded(
+        &self,
+        ray: &Ray,
+        departure: Option<Departure>,
+        t_max: f32,
+        ignore: Option<u32>,
+    ) -> bool {
+        self.accel.occluded(ray, departure, t_max, ignore)
+    }
+
+    pub fn material(&self, prim: u32) -> &Material {
+        &self.materials[self.prims[prim as usize].material as usize]
+    }
+
+    pub fn light_of(&self, prim: u32) -> Option<&DiskLight> {
+        self.light_of_prim[prim as usize].map(|i| &self.lights[i as usize])
+    }
+
+    /// Axis-aligned bounds of all primitives.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.bounds
+    }
+
+    /// Length of the bounds' diagonal: the scene's scale, for scale-free defaults.
+    pub fn diagonal(&self) -> f32 {
+        (self.bounds.1 - self.bounds.0).length()
+    }
+
+    /// Bounding spheres of the specular (mirror, glass) primitives.
+    pub fn specular_targets(&self) -> &[Target] {
+        &self.targets
+    }
+
+    /// Total emitted power per channel.
+    pub fn emitted_power(&self) -> Color {
+        self.lights.iter().map(|l| l.power()).sum()
+    }
+}

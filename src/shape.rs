@@ -1,0 +1,448 @@
+//! The course's shapes: triangles (Möller–Trumbore), spheres (analytic, both
+//! roots), disks, and tetrahedra as four triangles.
+//!
+//! Every intersection returns the hit point together with a bound on its
+//! rounding error, which [`crate::math::offset_ray_origin`] turns into a safe
+//! origin for the next ray. A ray leaving a surface also says which primitive
+//! it left and to which side ([`Departure`]): a ray can never meet the plane
+//! it leaves again, nor the outside of a convex sphere it leaves outwards, and
+//! a ray leaving a sphere inwards can only meet its far side. These exact
+//! rules replace the "ignore hits closer than epsilon" habit, which also
+//! ignores genuinely close surfaces.
+
+use crate::math::{gamma, Ray, Vertex};
+use glam::Vec3;
+
+/// Where a ray started: the primitive it left and whether it left along the
+/// primitive's geometric normal (`outward`) or against it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Departure {
+    pub prim: u32,
+    pub outward: bool,
+}
+
+/// A ray–shape intersection, before the scene attaches the primitive index.
+#[derive(Clone, Copy, Debug)]
+pub struct ShapeHit {
+    pub t: f32,
+    pub point: Vertex,
+    /// Bound on |computed point - exact point|, per axis.
+    pub p_err: Vec3,
+    /// Unit geometric normal as the shape defines it (not flipped to face the ray).
+    pub normal: Vec3,
+}
+
+/// A triangle with vertices `v0, v1, v2`; its normal is `(v1-v0) x (v2-v0)`
+/// normalised. Degenerate (zero-area) triangles are never hit.
+#[derive(Clone, Copy, Debug)]
+pub struct Triangle {
+    pub v0: Vertex,
+    pub v1: Vertex,
+    pub v2: Vertex,
+    pub normal: Vec3,
+}
+
+impl Triangle {
+    pub fn new(v0: Vertex, v1: Vertex, v2: Vertex) -> Self {
+        let normal = (v1 - v0)
+            .cross(v2 - v0)
+            .try_normalize()
+            .unwrap_or(Vec3::ZERO);
+        Triangle { v0, v1, v2, normal }
+    }
+
+    pub fn area(&self) -> f32 {
+        0.5 * (self.v1 - self.v0).cross(self.v2 - self.v0).length()
+    }
+
+    /// Möller–Trumbore (TNCG15 lecture 6): solves u E1 + v E2 - t D = T by
+    /// Cramer's rule. Hits on the edges (u = 0, v = 0, u + v = 1) count.
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
+        let e1 = self.v1 - self.v0;
+        let e2 = self.v2 - self.v0;
+        let p = ray.dir.cross(e2);
+        let det = p.dot(e1);
+        // det == 0: the ray is parallel to the plane, or the triangle is degenerate.
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let inv = 1.0 / det;
+        let tv = ray.origin - self.v0;
+        let u = p.dot(tv) * inv;
+        if !(0.0..=1.0).contains(&u) {
+            return None;
+        }
+        let q = tv.cross(e1);
+        let v = q.dot(ray.dir) * inv;
+        if v < 0.0 || u + v > 1.0 {
+            return None;
+        }
+        let t = q.dot(e2) * inv;
+        if !(t > 0.0 && t < t_max) || self.normal == Vec3::ZERO {
+            return None;
+        }
+        // The barycentric form is more accurate than o + t d, and its error is
+        // bounded by gamma(7) times the sum of the weighted vertex magnitudes.
+        let w = 1.0 - u - v;
+        let point = w * self.v0 + u * self.v1 + v * self.v2;
+        let p_err = gamma(7) * ((w * self.v0).abs() + (u * self.v1).abs() + (v * self.v2).abs());
+        Some(ShapeHit {
+            t,
+            point,
+            p_err,
+            normal: self.normal,
+        })
+    }
+}
+
+/// A sphere; its geometric normal points outwards.
+#[derive(Clone, Copy, Debug)]
+pub struct Sphere {
+    pub center: Vertex,
+    pub radius: f32,
+}
+
+impl Sphere {
+    /// `departed`: `Some(outward)` when the ray leaves this very sphere.
+    pub fn intersect(&self, ray: &Ray, t_max: f32, departed: Option<bool>) -> Option<ShapeHit> {
+        if !(self.radius > 0.0) {
+            return None;
+        }
+        // A convex body cannot be met again by a ray leaving its outside.
+        if departed == Some(true) {
+            return None;
+        }
+        let oc = ray.origin - self.center;
+        let b = oc.dot(ray.dir);
+        // Discriminant in the form that avoids cancellation (pbrt-v4 / Ray
+        // Tracing Gems ch. 7): r^2 - |oc - b d|^2.
+        let f = oc - b * ray.dir;
+        let disc = self.radius * self.radius - f.length_squared();
+        if disc < 0.0 {
+            return None;
+        }
+        let c = oc.length_squared() - self.radius * self.radius;
+        let q = -(b + disc.sqrt().copysign(b));
+        let (mut t0, mut t1) = if q == 0.0 { (0.0, 0.0) } else { (q, c / q) };
+        if t0 > t1 {
+            std::mem::swap(&mut t0, &mut t1);
+        }
+        // Leaving inwards: the near root is the departure point itself.
+        let t = if departed == Some(false) {
+            t1
+        } else if t0 > 0.0 {
+            t0
+        } else {
+            t1
+        };
+        if !(t > 0.0 && t < t_max) {
+            return None;
+        }
+        let local = ray.origin + t * ray.dir - self.center;
+        let len = local.length();
+        if !(len > 0.0) {
+            return None;
+        }
+        // Re-project onto the surface; the error is then a few ulps of the
+        // local coordinates plus the rounding of adding the centre back.
+        let local = local * (self.radius / len);
+        let point = self.center + local;
+        let p_err = gamma(5) * local.abs() + gamma(2) * point.abs();
+        Some(ShapeHit {
+            t,
+            point,
+            p_err,
+            normal: local / self.radius,
+        })
+    }
+}
+
+/// A flat disk with unit `normal`; one-sided emission is the light's concern,
+/// geometry is hit from both sides.
+#[derive(Clone, Copy, Debug)]
+pub struct Disk {
+    pub center: Vertex,
+    pub normal: Vec3,
+    pub radius: f32,
+}
+
+impl Disk {
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
+        let denom = ray.dir.dot(self.normal);
+        if denom == 0.0 || !(self.radius > 0.0) {
+            return None;
+        }
+        let t = (self.center - ray.origin).dot(self.normal) / denom;
+        if !(t > 0.0 && t < t_max) {
+            return None;
+        }
+        let p = ray.at(t);
+        let local = p - self.center;
+        // Project onto the plane exactly (removes the error along the normal).
+        let local = local - self.normal * local.dot(self.normal);
+        if local.length_squared() > self.radius * self.radius {
+            return None;
+        }
+        let point = self.center + local;
+        let p_err = gamma(6) * (local.abs() + self.center.abs() + point.abs());
+        Some(ShapeHit {
+            t,
+            point,
+            p_err,
+            normal: self.normal,
+        })
+    }
+
+    pub fn area(&self) -> f32 {
+        std::f32::consts::PI * self.radius * self.radius
+    }
+}
+
+/// The geometry of one primitive.
+#[derive(Clone, Copy, Debug)]
+pub enum Shape {
+    Triangle(Triangle),
+    Sphere(Sphere),
+    Disk(Disk),
+}
+
+impl Shape {
+    /// Closest intersection in (0, t_max), honouring the departure rules of the
+    /// module docs when `departed` is this primitive's own departure.
+    pub fn intersect(&self, ray: &Ray, t_max: f32, departed: Option<bool>) -> Option<ShapeHit> {
+        match self {
+            // A ray never meets the plane it leaves again.
+            Shape::Triangle(tri) if departed.is_none() => tri.intersect(ray, t_max),
+            Shape::Disk(disk) if departed.is_none() => disk.intersect(ray, t_max),
+            Shape::Triangle(_) | Shape::Disk(_) => None,
+            Shape::Sphere(s) => s.intersect(ray, t_max, departed),
+        }
+    }
+
+    /// Centre and radius of a sphere containing the shape.
+    pub fn bounding_sphere(&self) -> (Vertex, f32) {
+        match self {
+            Shape::Triangle(t) => {
+                let c = (t.v0 + t.v1 + t.v2) / 3.0;
+                let r = (t.v0 - c)
+                    .length()
+                    .max((t.v1 - c).length())
+                    .max((t.v2 - c).length());
+                (c, r)
+            }
+            Shape::Sphere(s) => (s.center, s.radius),
+            Shape::Disk(d) => (d.center, d.radius),
+        }
+    }
+
+    /// Axis-aligned bounds (min, max).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        match self {
+            Shape::Triangle(t) => (t.v0.min(t.v1).min(t.v2), t.v0.max(t.v1).max(t.v2)),
+            Shape::Sphere(s) => (
+                s.center - Vec3::splat(s.radius),
+                s.center + Vec3::splat(s.radius),
+            ),
+            Shape::Disk(d) => {
+                // Extent of a disk along axis i is r * sqrt(1 - n_i^2).
+                let e = d.radius * (Vec3::ONE - d.normal * d.normal).max(Vec3::ZERO).sqrt();
+                (d.center - e, d.center + e)
+            }
+        }
+    }
+}
+
+/// A tetrahedron as four triangles wound so that every normal points out.
+pub fn tetrahedron(a: Vertex, b: Vertex, c: Vertex, d: Vertex) -> [Triangle; 4] {
+    let centroid = (a + b + c + d) / 4.0;
+    let outward = |p: Vertex, q: Vertex, r: Vertex| {
+        let t = Triangle::new(p, q, r);
+        if t.normal.dot((p + q + r) / 3.0 - centroid) < 0.0 {
+            Triangle::new(p, r, q)
+        } else {
+            t
+        }
+    };
+    [
+        outward(a, b, c),
+        outward(a, b, d),
+        outward(b, c, d),
+        outward(c, a, d),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ray(o: [f32; 3], d: [f32; 3]) -> Ray {
+        Ray::new(Vec3::from(o), Vec3::from(d).normalize())
+    }
+
+    fn unit_triangle() -> Triangle {
+        Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y)
+    }
+
+    #[test]
+    fn triangle_hit_reports_distance_point_and_normal() {
+        let h = unit_triangle()
+            .intersect(&ray([0.2, 0.3, 2.0], [0.0, 0.0, -1.0]), f32::MAX)
+            .unwrap();
+        assert!((h.t - 2.0).abs() < 1e-6);
+        assert!((h.point - Vec3::new(0.2, 0.3, 0.0)).length() < 1e-6);
+        assert_eq!(h.normal, Vec3::Z);
+        // From below it is hit too (two-sided geometry), same normal.
+        let h = unit_triangle()
+            .intersect(&ray([0.2, 0.3, -1.0], [0.0, 0.0, 1.0]), f32::MAX)
+            .unwrap();
+        assert!((h.t - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn triangle_miss_outside_the_edges() {
+        let tri = unit_triangle();
+        for o in [
+            [0.6, 0.6, 1.0],
+            [-0.01, 0.5, 1.0],
+            [0.5, -0.01, 1.0],
+            [2.0, 2.0, 1.0],
+        ] {
+            assert!(
+                tri.intersect(&ray(o, [0.0, 0.0, -1.0]), f32::MAX).is_none(),
+                "{o:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn triangle_edges_and_vertices_count_as_hits() {
+        let tri = unit_triangle();
+        for o in [
+            [0.5, 0.0, 1.0],
+            [0.0, 0.5, 1.0],
+            [0.5, 0.5, 1.0],
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 1.0],
+        ] {
+            assert!(
+                tri.intersect(&ray(o, [0.0, 0.0, -1.0]), f32::MAX).is_some(),
+                "{o:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn triangle_parallel_behind_and_beyond_t_max_miss() {
+        let tri = unit_triangle();
+        assert!(tri
+            .intersect(&ray([0.2, 0.2, 0.0], [1.0, 0.0, 0.0]), f32::MAX)
+            .is_none());
+        assert!(tri
+            .intersect(&ray([0.2, 0.2, 1.0], [1.0, 1.0, 0.0]), f32::MAX)
+            .is_none());
+        assert!(tri
+            .intersect(&ray([0.2, 0.2, 1.0], [0.0, 0.0, 1.0]), f32::MAX)
+            .is_none());
+        assert!(tri
+            .intersect(&ray([0.2, 0.2, 1.0], [0.0, 0.0, -1.0]), 0.5)
+            .is_none());
+    }
+
+    #[test]
+    fn degenerate_triangles_are_never_hit() {
+        let line = Triangle::new(Vec3::ZERO, Vec3::X, 2.0 * Vec3::X);
+        let point = Triangle::new(Vec3::ONE, Vec3::ONE, Vec3::ONE);
+        for tri in [line, point] {
+            assert_eq!(tri.area(), 0.0);
+            for d in [[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]] {
+                assert!(tri.intersect(&ray([0.5, -1.0, 1.0], d), f32::MAX).is_none());
+            }
+        }
+    }
+
+    #[test]
+    fn sphere_from_outside_inside_tangent_and_behind() {
+        let s = Sphere {
+            center: Vec3::new(0.0, 0.0, 5.0),
+            radius: 1.0,
+        };
+        let h = s
+            .intersect(&ray([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]), f32::MAX, None)
+            .unwrap();
+        assert!((h.t - 4.0).abs() < 1e-5 && h.normal.dot(Vec3::Z) < -0.999);
+        // From the centre: the far root, normal pointing out along the ray.
+        let h = s
+            .intersect(&ray([0.0, 0.0, 5.0], [1.0, 0.0, 0.0]), f32::MAX, None)
+            .unwrap();
+        assert!((h.t - 1.0).abs() < 1e-6 && h.normal.dot(Vec3::X) > 0.999);
+        // Tangent: touches at x = 1 exactly.
+        let h = s
+            .intersect(&ray([1.0, -3.0, 5.0], [0.0, 1.0, 0.0]), f32::MAX, None)
+            .unwrap();
+        assert!((h.t - 3.0).abs() < 1e-3 && (h.point - Vec3::new(1.0, 0.0, 5.0)).length() < 1e-3);
+        // Just past tangent: a miss.
+        assert!(s
+            .intersect(&ray([1.001, -3.0, 5.0], [0.0, 1.0, 0.0]), f32::MAX, None)
+            .is_none());
+        // Behind the origin.
+        assert!(s
+            .intersect(&ray([0.0, 0.0, 0.0], [0.0, 0.0, -1.0]), f32::MAX, None)
+            .is_none());
+        // Zero radius is never hit.
+        let dot = Sphere {
+            center: Vec3::ZERO,
+            radius: 0.0,
+        };
+        assert!(dot
+            .intersect(&ray([0.0, 0.0, -1.0], [0.0, 0.0, 1.0]), f32::MAX, None)
+            .is_none());
+    }
+
+    #[test]
+    fn sphere_departure_rules() {
+        let s = Sphere {
+            center: Vec3::ZERO,
+            radius: 2.0,
+        };
+        let on = Vec3::new(0.0, 0.0, 2.0);
+        // Leaving inwards: only the far side, at the chord length.
+        let h = s
+            .intersect(&Ray::new(on, -Vec3::Z), f32::MAX, Some(false))
+            .unwrap();
+        assert!((h.t - 4.0).abs() < 1e-5);
+        // Leaving outwards, even straight back through: nothing.
+        assert!(s
+            .intersect(&Ray::new(on, -Vec3::Z), f32::MAX, Some(true))
+            .is_none());
+    }
+
+    #[test]
+    fn tetrahedron_normals_point_out() {
+        let [a, b, c, d] = [
+            Vec3::new(10.8, -1.0, -5.0),
+            Vec3::new(10.8, 1.0, -5.0),
+            Vec3::new(12.4, 0.0, -5.0),
+            Vec3::new(11.3, 0.0, -2.5),
+        ];
+        let centroid = (a + b + c + d) / 4.0;
+        for t in tetrahedron(a, b, c, d) {
+            assert!(t.normal.dot((t.v0 + t.v1 + t.v2) / 3.0 - centroid) > 0.0);
+        }
+    }
+
+    #[test]
+    fn disk_hit_and_rim() {
+        let d = Disk {
+            center: Vec3::new(8.0, 0.0, 4.999),
+            normal: -Vec3::Z,
+            radius: 1.0,
+        };
+        assert!(d
+            .intersect(&ray([8.5, 0.5, 0.0], [0.0, 0.0, 1.0]), f32::MAX)
+            .is_some());
+        assert!(d
+            .intersect(&ray([8.8, 0.8, 0.0], [0.0, 0.0, 1.0]), f32::MAX)
+            .is_none());
+        assert!((d.area() - std::f32::consts::PI).abs() < 1e-6);
+    }
+}
