@@ -1,58 +1,294 @@
-//! Closest-hit and occlusion queries over the scene's primitives.
-//!
-//! The default scene has 31 primitives, for which a flat loop over compact
-//! shapes is as fast as a hierarchy; every ray of the renderer goes through
-//! this one interface, so a BVH for large meshes can replace the loop here
-//! without touching any caller.
+//! Closest-hit and occlusion queries over the scene's primitives: a binary
+//! bounding volume hierarchy built with the binned surface area heuristic
+//! (16 bins), traversed near child first with the current closest distance
+//! pruning the far one. Every ray of the renderer goes through here.
 
 use crate::math::Ray;
 use crate::shape::{Departure, Shape, ShapeHit};
+use glam::Vec3;
+
+const BINS: usize = 16;
+/// Up to this many primitives a flat loop beats the hierarchy: the default
+/// room's 31 primitives are mostly large triangles whose boxes overlap the
+/// whole room, so box tests only add work (measured in notes/performance.md).
+pub const FLAT_LIMIT: usize = 64;
+const MAX_LEAF: usize = 4;
+
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    min: Vec3,
+    max: Vec3,
+    /// Interior: index of the first of two adjacent children. Leaf: index of
+    /// the first primitive in leaf order.
+    first: u32,
+    /// Primitives in the leaf; 0 for interior nodes.
+    count: u32,
+}
 
 pub struct Accel {
-    shapes: Vec<Shape>,
+    /// Empty when the primitives are few enough to test them all.
+    nodes: Vec<Node>,
+    /// Shapes in leaf order, with their index in the scene.
+    shapes: Vec<(Shape, u32)>,
+}
+
+#[derive(Clone, Copy)]
+struct Item {
+    min: Vec3,
+    max: Vec3,
+    centroid: Vec3,
+    index: u32,
+}
+
+fn area(min: Vec3, max: Vec3) -> f32 {
+    let d = (max - min).max(Vec3::ZERO);
+    2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
 }
 
 impl Accel {
     pub fn new(shapes: Vec<Shape>) -> Self {
-        Accel { shapes }
+        Self::with_flat_limit(shapes, FLAT_LIMIT)
+    }
+
+    /// As [`Accel::new`], choosing the flat loop up to `flat_limit` primitives.
+    pub fn with_flat_limit(shapes: Vec<Shape>, flat_limit: usize) -> Self {
+        if shapes.len() <= flat_limit {
+            let shapes = shapes.into_iter().enumerate().map(|(i, s)| (s, i as u32)).collect();
+            return Accel { nodes: Vec::new(), shapes };
+        }
+        let mut items: Vec<Item> = shapes
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                let (min, max) = s.bounds();
+                Item { min, max, centroid: 0.5 * (min + max), index: i as u32 }
+            })
+            .collect();
+        let mut nodes = Vec::with_capacity(2 * items.len().max(1));
+        nodes.push(Node { min: Vec3::ZERO, max: Vec3::ZERO, first: 0, count: 0 });
+        if !items.is_empty() {
+            build(&mut nodes, 0, &mut items, 0);
+        }
+        let ordered = items.iter().map(|it| (shapes[it.index as usize], it.index)).collect();
+        Accel { nodes, shapes: ordered }
     }
 
     /// Nearest hit in (0, t_max) and the index of the primitive hit.
-    pub fn closest_hit(
-        &self,
-        ray: &Ray,
-        departure: Option<Departure>,
-        mut t_max: f32,
-    ) -> Option<(u32, ShapeHit)> {
-        let mut best = None;
-        for (i, shape) in self.shapes.iter().enumerate() {
-            let departed = departure
-                .filter(|d| d.prim as usize == i)
-                .map(|d| d.outward);
-            if let Some(h) = shape.intersect(ray, t_max, departed) {
-                t_max = h.t;
-                best = Some((i as u32, h));
+    pub fn closest_hit(&self, ray: &Ray, departure: Option<Departure>, t_max: f32) -> Option<(u32, ShapeHit)> {
+        let mut best: Option<(&Shape, u32, f32, [f32; 2])> = None;
+        self.traverse(ray, t_max, |shape, index, t_limit| {
+            let departed = departure.filter(|d| d.prim == index).map(|d| d.outward);
+            if let Some((t, uv)) = shape.distance(ray, *t_limit, departed) {
+                *t_limit = t;
+                best = Some((shape, index, t, uv));
             }
-        }
-        best
+            false
+        });
+        // Only the nearest hit needs its point and error bound.
+        best.map(|(shape, index, t, uv)| (index, shape.record(ray, t, uv)))
     }
 
     /// Whether anything other than primitive `ignore` lies in (0, t_max).
-    pub fn occluded(
-        &self,
-        ray: &Ray,
-        departure: Option<Departure>,
-        t_max: f32,
-        ignore: Option<u32>,
-    ) -> bool {
-        self.shapes.iter().enumerate().any(|(i, shape)| {
-            if ignore == Some(i as u32) {
+    pub fn occluded(&self, ray: &Ray, departure: Option<Departure>, t_max: f32, ignore: Option<u32>) -> bool {
+        let mut blocked = false;
+        self.traverse(ray, t_max, |shape, index, t_limit| {
+            if ignore == Some(index) {
                 return false;
             }
-            let departed = departure
-                .filter(|d| d.prim as usize == i)
-                .map(|d| d.outward);
-            shape.intersect(ray, t_max, departed).is_some()
-        })
+            let departed = departure.filter(|d| d.prim == index).map(|d| d.outward);
+            blocked = shape.distance(ray, *t_limit, departed).is_some();
+            blocked
+        });
+        blocked
+    }
+
+    /// Visits the leaves whose boxes the ray enters before `t_limit`, nearer
+    /// boxes first; `visit` may shrink `t_limit`, and returns true to stop.
+    fn traverse<'s>(&'s self, ray: &Ray, t_max: f32, mut visit: impl FnMut(&'s Shape, u32, &mut f32) -> bool) {
+        if self.shapes.is_empty() {
+            return;
+        }
+        let mut t_limit = t_max;
+        if self.nodes.is_empty() {
+            for (shape, index) in &self.shapes {
+                if visit(shape, *index, &mut t_limit) {
+                    return;
+                }
+            }
+            return;
+        }
+        let inv = ray.dir.recip();
+        let mut stack = [0u32; 64];
+        let mut top = 0usize;
+        let mut node = 0u32;
+        loop {
+            let n = &self.nodes[node as usize];
+            if n.count > 0 {
+                for (shape, index) in &self.shapes[n.first as usize..(n.first + n.count) as usize] {
+                    if visit(shape, *index, &mut t_limit) {
+                        return;
+                    }
+                }
+            } else {
+                let (a, b) = (n.first, n.first + 1);
+                let ta = entry(&self.nodes[a as usize], ray, inv);
+                let tb = entry(&self.nodes[b as usize], ray, inv);
+                let (near, t_near, far, t_far) = if ta <= tb { (a, ta, b, tb) } else { (b, tb, a, ta) };
+                if t_near <= t_limit {
+                    if t_far <= t_limit && top < stack.len() {
+                        stack[top] = far;
+                        top += 1;
+                    }
+                    node = near;
+                    continue;
+                }
+            }
+            // Pop, skipping boxes that the shrinking closest hit now excludes.
+            loop {
+                if top == 0 {
+                    return;
+                }
+                top -= 1;
+                node = stack[top];
+                if entry(&self.nodes[node as usize], ray, inv) <= t_limit {
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/// Distance at which the ray enters the box (0 if it starts inside), or
+/// infinity if it misses. Written so that a NaN from 0 * inf never counts
+/// as a hit or a miss wrongly: max/min ignore a NaN operand.
+fn entry(n: &Node, ray: &Ray, inv: Vec3) -> f32 {
+    let t0 = (n.min - ray.origin) * inv;
+    let t1 = (n.max - ray.origin) * inv;
+    let near = t0.min(t1);
+    let far = t0.max(t1);
+    let t_in = near.x.max(near.y).max(near.z).max(0.0);
+    // Widen the exit by a few ulps so rounding never drops a box a ray grazes.
+    let t_out = far.x.min(far.y).min(far.z) * (1.0 + 2.0 * crate::math::gamma(3));
+    if t_in <= t_out {
+        t_in
+    } else {
+        f32::INFINITY
+    }
+}
+
+fn build(nodes: &mut Vec<Node>, node: usize, items: &mut [Item], offset: u32) {
+    let (min, max) = items.iter().fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(a, b), it| {
+        (a.min(it.min), b.max(it.max))
+    });
+    let leaf = Node { min, max, first: offset, count: items.len() as u32 };
+    if items.len() <= 1 {
+        nodes[node] = leaf;
+        return;
+    }
+    let (cmin, cmax) = items.iter().fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(a, b), it| {
+        (a.min(it.centroid), b.max(it.centroid))
+    });
+    let extent = cmax - cmin;
+    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    let mid = if extent[axis] > 0.0 {
+        // Binned SAH along the widest centroid axis.
+        let bin_of =
+            |it: &Item| (((it.centroid[axis] - cmin[axis]) / extent[axis] * BINS as f32) as usize).min(BINS - 1);
+        let mut counts = [0usize; BINS];
+        let mut bounds = [(Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)); BINS];
+        for it in items.iter() {
+            let b = bin_of(it);
+            counts[b] += 1;
+            bounds[b] = (bounds[b].0.min(it.min), bounds[b].1.max(it.max));
+        }
+        let mut best = (f32::INFINITY, 0usize);
+        for split in 1..BINS {
+            let side = |range: std::ops::Range<usize>| {
+                range.fold((0usize, Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(c, a, b), i| {
+                    (c + counts[i], a.min(bounds[i].0), b.max(bounds[i].1))
+                })
+            };
+            let (nl, al, bl) = side(0..split);
+            let (nr, ar, br) = side(split..BINS);
+            if nl == 0 || nr == 0 {
+                continue;
+            }
+            let cost = nl as f32 * area(al, bl) + nr as f32 * area(ar, br);
+            if cost < best.0 {
+                best = (cost, split);
+            }
+        }
+        let leaf_cost = items.len() as f32 * area(min, max);
+        if best.1 == 0 || (best.0 >= leaf_cost && items.len() <= MAX_LEAF) {
+            if items.len() <= MAX_LEAF {
+                nodes[node] = leaf;
+                return;
+            }
+            items.len() / 2
+        } else {
+            let mut i = 0;
+            for j in 0..items.len() {
+                if bin_of(&items[j]) < best.1 {
+                    items.swap(i, j);
+                    i += 1;
+                }
+            }
+            i
+        }
+    } else if items.len() <= MAX_LEAF {
+        nodes[node] = leaf;
+        return;
+    } else {
+        items.len() / 2
+    };
+    let first = nodes.len();
+    nodes.push(leaf);
+    nodes.push(leaf);
+    nodes[node] = Node { min, max, first: first as u32, count: 0 };
+    let (left, right) = items.split_at_mut(mid);
+    build(nodes, first, left, offset);
+    build(nodes, first + 1, right, offset + mid as u32);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::{next_2d, stream, uniform_cone, Domain};
+    use crate::shape::{Sphere, Triangle};
+
+    /// The hierarchy must find exactly what testing every shape finds.
+    #[test]
+    fn bvh_agrees_with_brute_force() {
+        let mut rng = stream(3, Domain::Camera, 0);
+        let mut shapes = Vec::new();
+        for _ in 0..300 {
+            let c = (glam::Vec3::new(next_2d(&mut rng).x, next_2d(&mut rng).x, next_2d(&mut rng).x) - 0.5) * 20.0;
+            if shapes.len() % 3 == 0 {
+                shapes.push(Shape::Sphere(Sphere { center: c, radius: 0.3 + next_2d(&mut rng).x }));
+            } else {
+                let d = |rng: &mut _| uniform_cone(next_2d(rng), -1.0) * 1.5;
+                shapes.push(Shape::Triangle(Triangle::new(c, c + d(&mut rng), c + d(&mut rng))));
+            }
+        }
+        let accel = Accel::with_flat_limit(shapes.clone(), 0);
+        for _ in 0..5000 {
+            let o = (glam::Vec3::new(next_2d(&mut rng).x, next_2d(&mut rng).x, next_2d(&mut rng).x) - 0.5) * 30.0;
+            let ray = Ray::new(o, uniform_cone(next_2d(&mut rng), -1.0));
+            let brute = shapes
+                .iter()
+                .enumerate()
+                .filter_map(|(i, s)| s.intersect(&ray, f32::INFINITY, None).map(|h| (i as u32, h.t)))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            let got = accel.closest_hit(&ray, None, f32::INFINITY).map(|(i, h)| (i, h.t));
+            assert_eq!(got, brute);
+            let t = brute.map_or(10.0, |b| b.1 * 1.01);
+            assert_eq!(accel.occluded(&ray, None, t, None), brute.is_some_and(|b| b.1 < t));
+        }
     }
 }

@@ -25,14 +25,7 @@ impl Camera {
     pub fn from_corners(eye: Vertex, corners: [Vertex; 4], width: u32, height: u32) -> Self {
         let [lower_right, lower_left, upper_left, upper_right] = corners;
         let _ = lower_right;
-        Camera {
-            eye,
-            upper_left,
-            across: upper_right - upper_left,
-            down: lower_left - upper_left,
-            width,
-            height,
-        }
+        Camera { eye, upper_left, across: upper_right - upper_left, down: lower_left - upper_left, width, height }
     }
 
     /// The same view at another resolution.
@@ -65,11 +58,7 @@ mod tests {
             let r = cam.ray(799 - i, 799 - j, Vec2::splat(0.5));
             let t = (0.0 - r.origin.x) / r.dir.x;
             let p = r.at(t);
-            let want = Vec3::new(
-                0.0,
-                i as f32 * 0.0025 - 0.99875,
-                j as f32 * 0.0025 - 0.99875,
-            );
+            let want = Vec3::new(0.0, i as f32 * 0.0025 - 0.99875, j as f32 * 0.0025 - 0.99875);
             assert!((p - want).length() < 1e-5, "{p} vs {want}");
         }
         // Field of view: the top edge's centre seen from e1 at 2*atan(1/2).
@@ -78,10 +67,7 @@ mod tests {
         let fov = top.dir.angle_between(bottom.dir).to_degrees();
         assert!((fov - 53.130).abs() < 0.01, "{fov}");
         let cam2 = Scene::tncg15(Eye::Two).camera;
-        let fov2 = cam2
-            .ray(400, 0, Vec2::ZERO)
-            .dir
-            .angle_between(cam2.ray(400, 799, Vec2::new(0.0, 1.0)).dir);
+        let fov2 = cam2.ray(400, 0, Vec2::ZERO).dir.angle_between(cam2.ray(400, 799, Vec2::new(0.0, 1.0)).dir);
         assert!((fov2.to_degrees() - 90.0).abs() < 0.01);
     }
 }

@@ -6,10 +6,7 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     #[error("{path}: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Io { path: PathBuf, source: std::io::Error },
     #[error("{path}: unknown output extension (use .exr, .png or .ppm)")]
     UnknownExtension { path: PathBuf },
     #[error("{path}: cannot write image: {message}")]

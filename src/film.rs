@@ -22,11 +22,7 @@ pub enum ToneMap {
 
 impl Film {
     pub fn new(width: u32, height: u32) -> Self {
-        Film {
-            width,
-            height,
-            pixels: vec![Color::ZERO; width as usize * height as usize],
-        }
+        Film { width, height, pixels: vec![Color::ZERO; width as usize * height as usize] }
     }
 
     pub fn get(&self, col: u32, row: u32) -> Color {
@@ -35,11 +31,7 @@ impl Film {
 
     /// Mean of all pixels and channels.
     pub fn mean(&self) -> f64 {
-        self.pixels
-            .iter()
-            .map(|c| (c.x + c.y + c.z) as f64)
-            .sum::<f64>()
-            / (3 * self.pixels.len()).max(1) as f64
+        self.pixels.iter().map(|c| (c.x + c.y + c.z) as f64).sum::<f64>() / (3 * self.pixels.len()).max(1) as f64
     }
 
     /// 8-bit RGB, row-major: radiance times `exposure`, mapped by `tonemap`
@@ -50,16 +42,8 @@ impl Film {
             ToneMap::Linear => v.max(0.0),
             ToneMap::Sqrt => v.max(0.0).sqrt(),
         };
-        let i_max = self
-            .pixels
-            .iter()
-            .fold(0.0f32, |m, c| m.max(c.max_element()))
-            * exposure.max(0.0);
-        let scale = if i_max > 0.0 {
-            255.99 / curve(i_max)
-        } else {
-            0.0
-        };
+        let i_max = self.pixels.iter().fold(0.0f32, |m, c| m.max(c.max_element())) * exposure.max(0.0);
+        let scale = if i_max > 0.0 { 255.99 / curve(i_max) } else { 0.0 };
         self.pixels
             .iter()
             .flat_map(|c| (*c * exposure).to_array())

@@ -29,12 +29,7 @@ pub struct LightSample {
 
 impl DiskLight {
     pub fn new(disk: Disk, radiance: Color, prim: u32) -> Self {
-        DiskLight {
-            disk,
-            radiance,
-            prim,
-            frame: Frame::from_normal(disk.normal),
-        }
+        DiskLight { disk, radiance, prim, frame: Frame::from_normal(disk.normal) }
     }
 
     pub fn area(&self) -> f32 {
@@ -87,11 +82,7 @@ mod tests {
     #[test]
     fn disk_irradiance_on_axis_matches_closed_form() {
         let light = DiskLight::new(
-            Disk {
-                center: Vec3::new(8.0, 0.0, 4.999),
-                normal: -Vec3::Z,
-                radius: 1.0,
-            },
+            Disk { center: Vec3::new(8.0, 0.0, 4.999), normal: -Vec3::Z, radius: 1.0 },
             Color::splat(10.0),
             0,
         );
@@ -111,10 +102,7 @@ mod tests {
             }
             let est = sum / n as f64;
             let exact = (PI * 10.0 / (1.0 + h * h)) as f64;
-            assert!(
-                (est - exact).abs() / exact < 0.01,
-                "h={h}: {est} vs {exact}"
-            );
+            assert!((est - exact).abs() / exact < 0.01, "h={h}: {est} vs {exact}");
         }
         // The spec's check: floor radiance below the light, direct only.
         let h = 4.999f64 + 5.0;

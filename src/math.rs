@@ -25,10 +25,7 @@ pub struct Ray {
 
 impl Ray {
     pub fn new(origin: Vertex, dir: Direction) -> Self {
-        debug_assert!(
-            dir.is_finite() && (dir.length() - 1.0).abs() < 1e-3,
-            "ray dir {dir}"
-        );
+        debug_assert!(dir.is_finite() && (dir.length() - 1.0).abs() < 1e-3, "ray dir {dir}");
         Ray { origin, dir }
     }
 

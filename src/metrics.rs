@@ -43,22 +43,14 @@ pub fn box_down(film: &Film, f: u32) -> Film {
 /// Compares `test` (any multiple of the reference's size) with `reference`.
 /// Non-finite test values are counted and treated as 0, as metrics.py does.
 pub fn compare(test: &Film, reference: &Film) -> Option<Metrics> {
-    if reference.width == 0
-        || test.width % reference.width != 0
-        || test.height % reference.height != 0
-    {
+    if reference.width == 0 || test.width % reference.width != 0 || test.height % reference.height != 0 {
         return None;
     }
     let f = test.width / reference.width;
     if test.height / reference.height != f {
         return None;
     }
-    let nan_count = test
-        .pixels
-        .iter()
-        .flat_map(|c| c.to_array())
-        .filter(|v| !v.is_finite())
-        .count() as u64;
+    let nan_count = test.pixels.iter().flat_map(|c| c.to_array()).filter(|v| !v.is_finite()).count() as u64;
     let clean = Film {
         width: test.width,
         height: test.height,

@@ -53,10 +53,7 @@ mod tests {
             for (a, b) in [(1.0, 1.5), (1.5, 1.0), (1.0, 2.4), (1.33, 1.0)] {
                 let r = fresnel_dielectric(c, a, b);
                 let t = 1.0 - r;
-                assert!(
-                    (0.0..=1.0).contains(&r) && (r + t - 1.0).abs() < 1e-7,
-                    "{c} {a} {b} {r}"
-                );
+                assert!((0.0..=1.0).contains(&r) && (r + t - 1.0).abs() < 1e-7, "{c} {a} {b} {r}");
             }
         }
         // Grazing incidence reflects everything.

@@ -17,18 +17,11 @@ pub enum Format {
 
 impl Format {
     pub fn from_path(path: &Path) -> Result<Format> {
-        match path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(|e| e.to_ascii_lowercase())
-            .as_deref()
-        {
+        match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
             Some("exr") => Ok(Format::Exr),
             Some("png") => Ok(Format::Png),
             Some("ppm") => Ok(Format::Ppm),
-            _ => Err(Error::UnknownExtension {
-                path: path.to_owned(),
-            }),
+            _ => Err(Error::UnknownExtension { path: path.to_owned() }),
         }
     }
 }
@@ -61,29 +54,19 @@ fn parent_dir(path: &Path) -> PathBuf {
 /// linear radiance as 32-bit floats; PNG and PPM hold the tone-mapped view.
 pub fn write(path: &Path, film: &Film, tonemap: ToneMap, exposure: f32) -> Result<()> {
     let format = check_writable(path)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let tmp = parent_dir(path).join(format!(".{name}.{}.tmp", std::process::id()));
     let written = match format {
         Format::Exr => write_exr(&tmp, film),
         Format::Png | Format::Ppm => write_rgb8(&tmp, film, tonemap, exposure, format),
     };
-    let result = written.and_then(|()| {
-        std::fs::rename(&tmp, path).map_err(|e| Error::Io {
-            path: path.to_owned(),
-            source: e,
-        })
-    });
+    let result =
+        written.and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::Io { path: path.to_owned(), source: e }));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
     result.map_err(|e| match e {
-        Error::Encode { message, .. } => Error::Encode {
-            path: path.to_owned(),
-            message,
-        },
+        Error::Encode { message, .. } => Error::Encode { path: path.to_owned(), message },
         other => other,
     })
 }
@@ -94,33 +77,14 @@ fn write_exr(tmp: &Path, film: &Film) -> Result<()> {
         let c = film.pixels[y * w + x];
         (c.x, c.y, c.z)
     })
-    .map_err(|e| Error::Encode {
-        path: tmp.to_owned(),
-        message: e.to_string(),
-    })
+    .map_err(|e| Error::Encode { path: tmp.to_owned(), message: e.to_string() })
 }
 
-fn write_rgb8(
-    tmp: &Path,
-    film: &Film,
-    tonemap: ToneMap,
-    exposure: f32,
-    format: Format,
-) -> Result<()> {
+fn write_rgb8(tmp: &Path, film: &Film, tonemap: ToneMap, exposure: f32, format: Format) -> Result<()> {
     let buf = image::RgbImage::from_raw(film.width, film.height, film.to_rgb8(tonemap, exposure))
-        .ok_or_else(|| Error::Encode {
-        path: tmp.to_owned(),
-        message: "image size mismatch".into(),
-    })?;
-    let fmt = if format == Format::Png {
-        image::ImageFormat::Png
-    } else {
-        image::ImageFormat::Pnm
-    };
-    buf.save_with_format(tmp, fmt).map_err(|e| Error::Encode {
-        path: tmp.to_owned(),
-        message: e.to_string(),
-    })
+        .ok_or_else(|| Error::Encode { path: tmp.to_owned(), message: "image size mismatch".into() })?;
+    let fmt = if format == Format::Png { image::ImageFormat::Png } else { image::ImageFormat::Pnm };
+    buf.save_with_format(tmp, fmt).map_err(|e| Error::Encode { path: tmp.to_owned(), message: e.to_string() })
 }
 
 /// Reads the first RGB layer of an EXR file as linear radiance.
@@ -133,15 +97,8 @@ pub fn read_exr(path: &Path) -> Result<Film> {
             px[p.y() * *w + p.x()] = Color::new(r, g, b)
         },
     )
-    .map_err(|e| crate::error::Error::Decode {
-        path: path.to_owned(),
-        message: e.to_string(),
-    })?;
+    .map_err(|e| crate::error::Error::Decode { path: path.to_owned(), message: e.to_string() })?;
     let size = image.layer_data.size;
     let (_, pixels) = image.layer_data.channel_data.pixels;
-    Ok(Film {
-        width: size.width() as u32,
-        height: size.height() as u32,
-        pixels,
-    })
+    Ok(Film { width: size.width() as u32, height: size.height() as u32, pixels })
 }

@@ -37,21 +37,15 @@ impl Phase {
     pub fn start(mode: Mode, label: &'static str, total: u64) -> Phase {
         let bar = (mode == Mode::Bar).then(|| {
             let bar = ProgressBar::new(total);
-            if let Ok(style) = ProgressStyle::with_template(
-                "{msg:>14} [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}",
-            ) {
+            if let Ok(style) =
+                ProgressStyle::with_template("{msg:>14} [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}")
+            {
                 bar.set_style(style.progress_chars("=> "));
             }
             bar.set_message(label);
             bar
         });
-        Phase {
-            mode,
-            label,
-            total,
-            done: AtomicU64::new(0),
-            bar,
-        }
+        Phase { mode, label, total, done: AtomicU64::new(0), bar }
     }
 
     pub fn advance(&self, n: u64) {

@@ -71,13 +71,11 @@ pub const CAUSTIC_RADIUS_FRACTION: f32 = 0.01;
 
 impl Settings {
     pub fn r_global(&self, scene: &Scene) -> f32 {
-        self.r_global
-            .unwrap_or(GLOBAL_RADIUS_FRACTION * scene.diagonal())
+        self.r_global.unwrap_or(GLOBAL_RADIUS_FRACTION * scene.diagonal())
     }
 
     pub fn r_caustic(&self, scene: &Scene) -> f32 {
-        self.r_caustic
-            .unwrap_or(CAUSTIC_RADIUS_FRACTION * scene.diagonal())
+        self.r_caustic.unwrap_or(CAUSTIC_RADIUS_FRACTION * scene.diagonal())
     }
 }
 
@@ -107,28 +105,13 @@ pub struct Stats {
 
 /// Renders `scene` (its camera at `settings`' resolution) with photon mapping.
 pub fn render(scene: &Scene, settings: &Settings, progress: Mode) -> (Film, Stats) {
-    let mut stats = Stats {
-        r_global: settings.r_global(scene),
-        r_caustic: settings.r_caustic(scene),
-        ..Stats::default()
-    };
+    let mut stats =
+        Stats { r_global: settings.r_global(scene), r_caustic: settings.r_caustic(scene), ..Stats::default() };
 
     let t = Instant::now();
-    let phase = Phase::start(
-        progress,
-        "photon pass",
-        settings.photons + settings.caustic_photons,
-    );
-    let global = trace_pass(scene, Pass::Global, settings.photons, settings.seed, &|n| {
-        phase.advance(n)
-    });
-    let caustic = trace_pass(
-        scene,
-        Pass::Caustic,
-        settings.caustic_photons,
-        settings.seed,
-        &|n| phase.advance(n),
-    );
+    let phase = Phase::start(progress, "photon pass", settings.photons + settings.caustic_photons);
+    let global = trace_pass(scene, Pass::Global, settings.photons, settings.seed, &|n| phase.advance(n));
+    let caustic = trace_pass(scene, Pass::Caustic, settings.caustic_photons, settings.seed, &|n| phase.advance(n));
     phase.finish();
     stats.photon_time = t.elapsed();
     stats.global_emitted = global.emitted;
@@ -139,12 +122,7 @@ pub fn render(scene: &Scene, settings: &Settings, progress: Mode) -> (Film, Stat
     let t = Instant::now();
     let global_map = PhotonMap::build(global.photons);
     let caustic_map = PhotonMap::build(caustic.photons);
-    let cache = IrradianceCache::build(
-        &global_map,
-        settings.cache_stride,
-        settings.k_global,
-        stats.r_global,
-    );
+    let cache = IrradianceCache::build(&global_map, settings.cache_stride, settings.k_global, stats.r_global);
     stats.build_time = t.elapsed();
     stats.global_stored = global_map.len();
     stats.caustic_stored = caustic_map.len();
@@ -180,12 +158,7 @@ const PROBES: u32 = 4;
 /// whose neighbours' probes disagree with theirs (a rim thinner than the probe
 /// spacing). The probes use their own random streams, so choosing the pixels
 /// does not bias the samples that later estimate them.
-fn light_rims(
-    camera: &Camera,
-    integrator: &PhotonIntegrator,
-    seed: u64,
-    tally: &mut Tally,
-) -> Vec<bool> {
+fn light_rims(camera: &Camera, integrator: &PhotonIntegrator, seed: u64, tally: &mut Tally) -> Vec<bool> {
     let (w, h) = (camera.width, camera.height);
     let rows: Vec<(Vec<u8>, Tally)> = (0..h)
         .into_par_iter()
@@ -197,14 +170,8 @@ fn light_rims(
                     let mut rng = stream(seed, Domain::EdgeProbes, pixel);
                     (0..PROBES)
                         .filter(|&s| {
-                            let ray =
-                                camera.ray(col, row, stratified_2d(s, PROBES, next_2d(&mut rng)));
-                            let mut ctx = Context {
-                                rng: &mut rng,
-                                scratch,
-                                tally: &mut tally,
-                                pixel,
-                            };
+                            let ray = camera.ray(col, row, stratified_2d(s, PROBES, next_2d(&mut rng)));
+                            let mut ctx = Context { rng: &mut rng, scratch, tally: &mut tally, pixel };
                             max_component(integrator.radiance(ray, Part::Emitted, &mut ctx)) > 0.0
                         })
                         .count() as u8
@@ -240,12 +207,7 @@ fn light_rims(
 /// rim of a light's image estimate the emitted part with `edge_spp` samples
 /// of their own. Each pixel has its own random stream, so rows can run on any
 /// thread in any order.
-fn camera_pass(
-    scene: &Scene,
-    settings: &Settings,
-    integrator: &PhotonIntegrator,
-    progress: Mode,
-) -> (Film, Tally) {
+fn camera_pass(scene: &Scene, settings: &Settings, integrator: &PhotonIntegrator, progress: Mode) -> (Film, Tally) {
     let (w, h) = (settings.width, settings.height);
     let camera = scene.camera.with_resolution(w, h);
     let spp = settings.spp.max(1);
@@ -271,12 +233,7 @@ fn camera_pass(
                         for s in 0..n {
                             let u = stratified_2d(s, n, next_2d(&mut rng));
                             let ray = camera.ray(col, row, u);
-                            let mut ctx = Context {
-                                rng: &mut rng,
-                                scratch,
-                                tally: &mut tally,
-                                pixel,
-                            };
+                            let mut ctx = Context { rng: &mut rng, scratch, tally: &mut tally, pixel };
                             sum += integrator.radiance(ray, part, &mut ctx).as_dvec3();
                         }
                         sum / n as f64

@@ -42,13 +42,7 @@ impl Hit {
     /// A ray leaving this hit along unit `dir`, with its departure record.
     pub fn spawn(&self, dir: Vec3) -> (Ray, Departure) {
         let origin = offset_ray_origin(self.point, self.p_err, self.normal, dir);
-        (
-            Ray::new(origin, dir),
-            Departure {
-                prim: self.prim,
-                outward: dir.dot(self.normal) > 0.0,
-            },
-        )
+        (Ray::new(origin, dir), Departure { prim: self.prim, outward: dir.dot(self.normal) > 0.0 })
     }
 }
 
@@ -83,12 +77,7 @@ pub enum Eye {
 impl Scene {
     /// Assembles a scene; the disk lights are added as primitives too, so that
     /// camera rays see them and photons are absorbed by them.
-    pub fn new(
-        mut prims: Vec<Prim>,
-        mut materials: Vec<Material>,
-        lights: Vec<(Disk, Color)>,
-        camera: Camera,
-    ) -> Self {
+    pub fn new(mut prims: Vec<Prim>, mut materials: Vec<Material>, lights: Vec<(Disk, Color)>, camera: Camera) -> Self {
         let mut light_of_prim = vec![None; prims.len()];
         let mut disk_lights = Vec::new();
         if !lights.is_empty() {
@@ -97,10 +86,7 @@ impl Scene {
         let emitter = materials.len() as u32 - 1;
         for (disk, radiance) in lights {
             let prim = prims.len() as u32;
-            prims.push(Prim {
-                shape: Shape::Disk(disk),
-                material: emitter,
-            });
+            prims.push(Prim { shape: Shape::Disk(disk), material: emitter });
             light_of_prim.push(Some(disk_lights.len() as u32));
             disk_lights.push(DiskLight::new(disk, radiance, prim));
         }
@@ -120,16 +106,7 @@ impl Scene {
             })
             .collect();
         let accel = Accel::new(prims.iter().map(|p| p.shape).collect());
-        Scene {
-            prims,
-            materials,
-            lights: disk_lights,
-            camera,
-            light_of_prim,
-            accel,
-            bounds: (lo, hi),
-            targets,
-        }
+        Scene { prims, materials, lights: disk_lights, camera, light_of_prim, accel, bounds: (lo, hi), targets }
     }
 
     /// The built-in TNCG15 room (see notes/default-scene.md), 800 x 800.
@@ -158,15 +135,8 @@ impl Scene {
         // Wind each room triangle so its normal points into the room.
         let mut room_triangle = |a: Vec3, b: Vec3, c: Vec3, material: u32| {
             let t = Triangle::new(a, b, c);
-            let t = if t.normal.dot(inside - a) < 0.0 {
-                Triangle::new(a, c, b)
-            } else {
-                t
-            };
-            prims.push(Prim {
-                shape: Shape::Triangle(t),
-                material,
-            });
+            let t = if t.normal.dot(inside - a) < 0.0 { Triangle::new(a, c, b) } else { t };
+            prims.push(Prim { shape: Shape::Triangle(t), material });
         };
         // Floor and ceiling: a fan of six triangles around the hexagon's centre.
         let centre = Vec2::new(5.0, 0.0);
@@ -181,36 +151,21 @@ impl Scene {
             let m = materials.len() as u32 - 1;
             let (a, b) = (hexagon[i], hexagon[(i + 1) % 6]);
             room_triangle(a.extend(floor_z), b.extend(floor_z), b.extend(ceiling_z), m);
-            room_triangle(
-                a.extend(floor_z),
-                b.extend(ceiling_z),
-                a.extend(ceiling_z),
-                m,
-            );
+            room_triangle(a.extend(floor_z), b.extend(ceiling_z), a.extend(ceiling_z), m);
         }
         materials.push(Material::Glass { ior: 1.5 });
         let glass = materials.len() as u32 - 1;
         prims.push(Prim {
-            shape: Shape::Sphere(Sphere {
-                center: Vec3::new(9.5, -2.0, -3.0),
-                radius: 1.5,
-            }),
+            shape: Shape::Sphere(Sphere { center: Vec3::new(9.5, -2.0, -3.0), radius: 1.5 }),
             material: glass,
         });
-        materials.push(Material::Mirror {
-            reflectance: Color::splat(0.95),
-        });
+        materials.push(Material::Mirror { reflectance: Color::splat(0.95) });
         let mirror = materials.len() as u32 - 1;
         prims.push(Prim {
-            shape: Shape::Sphere(Sphere {
-                center: Vec3::new(10.0, 2.5, -3.6),
-                radius: 1.4,
-            }),
+            shape: Shape::Sphere(Sphere { center: Vec3::new(10.0, 2.5, -3.6), radius: 1.4 }),
             material: mirror,
         });
-        materials.push(Material::Lambertian {
-            rho: Color::new(0.9, 0.6, 0.1),
-        });
+        materials.push(Material::Lambertian { rho: Color::new(0.9, 0.6, 0.1) });
         let tet = materials.len() as u32 - 1;
         for t in tetrahedron(
             Vec3::new(10.8, -1.0, -5.0),
@@ -218,16 +173,9 @@ impl Scene {
             Vec3::new(12.4, 0.0, -5.0),
             Vec3::new(11.3, 0.0, -2.5),
         ) {
-            prims.push(Prim {
-                shape: Shape::Triangle(t),
-                material: tet,
-            });
+            prims.push(Prim { shape: Shape::Triangle(t), material: tet });
         }
-        let light = Disk {
-            center: Vec3::new(8.0, 0.0, 4.999),
-            normal: -Vec3::Z,
-            radius: 1.0,
-        };
+        let light = Disk { center: Vec3::new(8.0, 0.0, 4.999), normal: -Vec3::Z, radius: 1.0 };
         let eye_point = match eye {
             Eye::One => Vec3::new(-2.0, 0.0, 0.0),
             Eye::Two => Vec3::new(-1.0, 0.0, 0.0),
@@ -248,26 +196,18 @@ impl Scene {
     }
 
     pub fn intersect(&self, ray: &Ray, departure: Option<Departure>) -> Option<Hit> {
-        self.accel
-            .closest_hit(ray, departure, f32::INFINITY)
-            .map(|(prim, h)| Hit {
-                t: h.t,
-                point: h.point,
-                p_err: h.p_err,
-                normal: h.normal,
-                prim,
-            })
+        self.accel.closest_hit(ray, departure, f32::INFINITY).map(|(prim, h)| Hit {
+            t: h.t,
+            point: h.point,
+            p_err: h.p_err,
+            normal: h.normal,
+            prim,
+        })
     }
 
     /// Whether the segment from the ray's origin to `t_max` is blocked by
     /// anything but primitive `ignore` (the light being aimed at).
-    pub fn occluded(
-        &self,
-        ray: &Ray,
-        departure: Option<Departure>,
-        t_max: f32,
-        ignore: Option<u32>,
-    ) -> bool {
+    pub fn occluded(&self, ray: &Ray, departure: Option<Departure>, t_max: f32, ignore: Option<u32>) -> bool {
         self.accel.occluded(ray, departure, t_max, ignore)
     }
 

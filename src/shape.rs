@@ -40,15 +40,16 @@ pub struct Triangle {
     pub v1: Vertex,
     pub v2: Vertex,
     pub normal: Vec3,
+    /// Edges v1 - v0 and v2 - v0, kept for Möller–Trumbore.
+    e1: Vec3,
+    e2: Vec3,
 }
 
 impl Triangle {
     pub fn new(v0: Vertex, v1: Vertex, v2: Vertex) -> Self {
-        let normal = (v1 - v0)
-            .cross(v2 - v0)
-            .try_normalize()
-            .unwrap_or(Vec3::ZERO);
-        Triangle { v0, v1, v2, normal }
+        let (e1, e2) = (v1 - v0, v2 - v0);
+        let normal = e1.cross(e2).try_normalize().unwrap_or(Vec3::ZERO);
+        Triangle { v0, v1, v2, normal, e1, e2 }
     }
 
     pub fn area(&self) -> f32 {
@@ -58,40 +59,51 @@ impl Triangle {
     /// Möller–Trumbore (TNCG15 lecture 6): solves u E1 + v E2 - t D = T by
     /// Cramer's rule. Hits on the edges (u = 0, v = 0, u + v = 1) count.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
-        let e1 = self.v1 - self.v0;
-        let e2 = self.v2 - self.v0;
-        let p = ray.dir.cross(e2);
-        let det = p.dot(e1);
+        self.distance(ray, t_max).map(|(t, u, v)| self.record(t, u, v))
+    }
+
+    /// The distance and barycentric (u, v) of a hit in (0, t_max). The
+    /// division by the determinant is left to the end, so the common miss
+    /// costs only multiplications and comparisons.
+    #[inline]
+    pub fn distance(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32, f32)> {
+        if self.normal == Vec3::ZERO {
+            return None;
+        }
+        let p = ray.dir.cross(self.e2);
+        let det = p.dot(self.e1);
         // det == 0: the ray is parallel to the plane, or the triangle is degenerate.
         if det == 0.0 || !det.is_finite() {
             return None;
         }
-        let inv = 1.0 / det;
+        let sign = 1.0f32.copysign(det);
+        let abs_det = det.abs();
         let tv = ray.origin - self.v0;
-        let u = p.dot(tv) * inv;
-        if !(0.0..=1.0).contains(&u) {
+        let u = p.dot(tv) * sign;
+        if u < 0.0 || u > abs_det {
             return None;
         }
-        let q = tv.cross(e1);
-        let v = q.dot(ray.dir) * inv;
-        if v < 0.0 || u + v > 1.0 {
+        let q = tv.cross(self.e1);
+        let v = q.dot(ray.dir) * sign;
+        if v < 0.0 || u + v > abs_det {
             return None;
         }
-        let t = q.dot(e2) * inv;
-        if !(t > 0.0 && t < t_max) || self.normal == Vec3::ZERO {
+        let t = q.dot(self.e2) * sign;
+        if !(t > 0.0 && t < t_max * abs_det) {
             return None;
         }
-        // The barycentric form is more accurate than o + t d, and its error is
-        // bounded by gamma(7) times the sum of the weighted vertex magnitudes.
+        let inv = 1.0 / abs_det;
+        Some((t * inv, u * inv, v * inv))
+    }
+
+    /// The hit record at barycentric (u, v): the barycentric form of the point
+    /// is more accurate than o + t d, and its error is bounded by gamma(7)
+    /// times the sum of the weighted vertex magnitudes.
+    pub fn record(&self, t: f32, u: f32, v: f32) -> ShapeHit {
         let w = 1.0 - u - v;
         let point = w * self.v0 + u * self.v1 + v * self.v2;
         let p_err = gamma(7) * ((w * self.v0).abs() + (u * self.v1).abs() + (v * self.v2).abs());
-        Some(ShapeHit {
-            t,
-            point,
-            p_err,
-            normal: self.normal,
-        })
+        ShapeHit { t, point, p_err, normal: self.normal }
     }
 }
 
@@ -105,6 +117,12 @@ pub struct Sphere {
 impl Sphere {
     /// `departed`: `Some(outward)` when the ray leaves this very sphere.
     pub fn intersect(&self, ray: &Ray, t_max: f32, departed: Option<bool>) -> Option<ShapeHit> {
+        self.distance(ray, t_max, departed).map(|t| self.record(ray, t))
+    }
+
+    /// Distance to the hit in (0, t_max) that the departure rules allow.
+    #[inline]
+    pub fn distance(&self, ray: &Ray, t_max: f32, departed: Option<bool>) -> Option<f32> {
         if !(self.radius > 0.0) {
             return None;
         }
@@ -135,25 +153,22 @@ impl Sphere {
         } else {
             t1
         };
-        if !(t > 0.0 && t < t_max) {
-            return None;
-        }
+        (t > 0.0 && t < t_max).then_some(t)
+    }
+
+    /// The hit record at distance `t` (from [`Sphere::distance`]).
+    pub fn record(&self, ray: &Ray, t: f32) -> ShapeHit {
         let local = ray.origin + t * ray.dir - self.center;
         let len = local.length();
-        if !(len > 0.0) {
-            return None;
-        }
+        // A hit point at the centre needs a zero radius, which never hits.
+        let local = if len > 0.0 { local } else { Vec3::Z * self.radius };
+        let len = local.length();
         // Re-project onto the surface; the error is then a few ulps of the
         // local coordinates plus the rounding of adding the centre back.
         let local = local * (self.radius / len);
         let point = self.center + local;
         let p_err = gamma(5) * local.abs() + gamma(2) * point.abs();
-        Some(ShapeHit {
-            t,
-            point,
-            p_err,
-            normal: local / self.radius,
-        })
+        ShapeHit { t, point, p_err, normal: local / self.radius }
     }
 }
 
@@ -168,6 +183,11 @@ pub struct Disk {
 
 impl Disk {
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
+        self.distance(ray, t_max).map(|t| self.record(ray, t))
+    }
+
+    #[inline]
+    pub fn distance(&self, ray: &Ray, t_max: f32) -> Option<f32> {
         let denom = ray.dir.dot(self.normal);
         if denom == 0.0 || !(self.radius > 0.0) {
             return None;
@@ -176,21 +196,18 @@ impl Disk {
         if !(t > 0.0 && t < t_max) {
             return None;
         }
-        let p = ray.at(t);
-        let local = p - self.center;
+        let local = ray.at(t) - self.center;
+        let local = local - self.normal * local.dot(self.normal);
+        (local.length_squared() <= self.radius * self.radius).then_some(t)
+    }
+
+    pub fn record(&self, ray: &Ray, t: f32) -> ShapeHit {
+        let local = ray.at(t) - self.center;
         // Project onto the plane exactly (removes the error along the normal).
         let local = local - self.normal * local.dot(self.normal);
-        if local.length_squared() > self.radius * self.radius {
-            return None;
-        }
         let point = self.center + local;
         let p_err = gamma(6) * (local.abs() + self.center.abs() + point.abs());
-        Some(ShapeHit {
-            t,
-            point,
-            p_err,
-            normal: self.normal,
-        })
+        ShapeHit { t, point, p_err, normal: self.normal }
     }
 
     pub fn area(&self) -> f32 {
@@ -210,12 +227,28 @@ impl Shape {
     /// Closest intersection in (0, t_max), honouring the departure rules of the
     /// module docs when `departed` is this primitive's own departure.
     pub fn intersect(&self, ray: &Ray, t_max: f32, departed: Option<bool>) -> Option<ShapeHit> {
+        self.distance(ray, t_max, departed).map(|(t, uv)| self.record(ray, t, uv))
+    }
+
+    /// Distance to the intersection (and the triangle's barycentrics, for
+    /// [`Shape::record`]), without building the hit record.
+    #[inline]
+    pub fn distance(&self, ray: &Ray, t_max: f32, departed: Option<bool>) -> Option<(f32, [f32; 2])> {
         match self {
             // A ray never meets the plane it leaves again.
-            Shape::Triangle(tri) if departed.is_none() => tri.intersect(ray, t_max),
-            Shape::Disk(disk) if departed.is_none() => disk.intersect(ray, t_max),
-            Shape::Triangle(_) | Shape::Disk(_) => None,
-            Shape::Sphere(s) => s.intersect(ray, t_max, departed),
+            Shape::Triangle(_) | Shape::Disk(_) if departed.is_some() => None,
+            Shape::Triangle(tri) => tri.distance(ray, t_max).map(|(t, u, v)| (t, [u, v])),
+            Shape::Disk(disk) => disk.distance(ray, t_max).map(|t| (t, [0.0; 2])),
+            Shape::Sphere(s) => s.distance(ray, t_max, departed).map(|t| (t, [0.0; 2])),
+        }
+    }
+
+    /// The hit record of a distance found by [`Shape::distance`].
+    pub fn record(&self, ray: &Ray, t: f32, uv: [f32; 2]) -> ShapeHit {
+        match self {
+            Shape::Triangle(tri) => tri.record(t, uv[0], uv[1]),
+            Shape::Disk(disk) => disk.record(ray, t),
+            Shape::Sphere(s) => s.record(ray, t),
         }
     }
 
@@ -224,10 +257,7 @@ impl Shape {
         match self {
             Shape::Triangle(t) => {
                 let c = (t.v0 + t.v1 + t.v2) / 3.0;
-                let r = (t.v0 - c)
-                    .length()
-                    .max((t.v1 - c).length())
-                    .max((t.v2 - c).length());
+                let r = (t.v0 - c).length().max((t.v1 - c).length()).max((t.v2 - c).length());
                 (c, r)
             }
             Shape::Sphere(s) => (s.center, s.radius),
@@ -239,10 +269,7 @@ impl Shape {
     pub fn bounds(&self) -> (Vec3, Vec3) {
         match self {
             Shape::Triangle(t) => (t.v0.min(t.v1).min(t.v2), t.v0.max(t.v1).max(t.v2)),
-            Shape::Sphere(s) => (
-                s.center - Vec3::splat(s.radius),
-                s.center + Vec3::splat(s.radius),
-            ),
+            Shape::Sphere(s) => (s.center - Vec3::splat(s.radius), s.center + Vec3::splat(s.radius)),
             Shape::Disk(d) => {
                 // Extent of a disk along axis i is r * sqrt(1 - n_i^2).
                 let e = d.radius * (Vec3::ONE - d.normal * d.normal).max(Vec3::ZERO).sqrt();
@@ -263,12 +290,7 @@ pub fn tetrahedron(a: Vertex, b: Vertex, c: Vertex, d: Vertex) -> [Triangle; 4] 
             t
         }
     };
-    [
-        outward(a, b, c),
-        outward(a, b, d),
-        outward(b, c, d),
-        outward(c, a, d),
-    ]
+    [outward(a, b, c), outward(a, b, d), outward(b, c, d), outward(c, a, d)]
 }
 
 #[cfg(test)]
@@ -285,67 +307,38 @@ mod tests {
 
     #[test]
     fn triangle_hit_reports_distance_point_and_normal() {
-        let h = unit_triangle()
-            .intersect(&ray([0.2, 0.3, 2.0], [0.0, 0.0, -1.0]), f32::MAX)
-            .unwrap();
+        let h = unit_triangle().intersect(&ray([0.2, 0.3, 2.0], [0.0, 0.0, -1.0]), f32::MAX).unwrap();
         assert!((h.t - 2.0).abs() < 1e-6);
         assert!((h.point - Vec3::new(0.2, 0.3, 0.0)).length() < 1e-6);
         assert_eq!(h.normal, Vec3::Z);
         // From below it is hit too (two-sided geometry), same normal.
-        let h = unit_triangle()
-            .intersect(&ray([0.2, 0.3, -1.0], [0.0, 0.0, 1.0]), f32::MAX)
-            .unwrap();
+        let h = unit_triangle().intersect(&ray([0.2, 0.3, -1.0], [0.0, 0.0, 1.0]), f32::MAX).unwrap();
         assert!((h.t - 1.0).abs() < 1e-6);
     }
 
     #[test]
     fn triangle_miss_outside_the_edges() {
         let tri = unit_triangle();
-        for o in [
-            [0.6, 0.6, 1.0],
-            [-0.01, 0.5, 1.0],
-            [0.5, -0.01, 1.0],
-            [2.0, 2.0, 1.0],
-        ] {
-            assert!(
-                tri.intersect(&ray(o, [0.0, 0.0, -1.0]), f32::MAX).is_none(),
-                "{o:?}"
-            );
+        for o in [[0.6, 0.6, 1.0], [-0.01, 0.5, 1.0], [0.5, -0.01, 1.0], [2.0, 2.0, 1.0]] {
+            assert!(tri.intersect(&ray(o, [0.0, 0.0, -1.0]), f32::MAX).is_none(), "{o:?}");
         }
     }
 
     #[test]
     fn triangle_edges_and_vertices_count_as_hits() {
         let tri = unit_triangle();
-        for o in [
-            [0.5, 0.0, 1.0],
-            [0.0, 0.5, 1.0],
-            [0.5, 0.5, 1.0],
-            [0.0, 0.0, 1.0],
-            [1.0, 0.0, 1.0],
-        ] {
-            assert!(
-                tri.intersect(&ray(o, [0.0, 0.0, -1.0]), f32::MAX).is_some(),
-                "{o:?}"
-            );
+        for o in [[0.5, 0.0, 1.0], [0.0, 0.5, 1.0], [0.5, 0.5, 1.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0]] {
+            assert!(tri.intersect(&ray(o, [0.0, 0.0, -1.0]), f32::MAX).is_some(), "{o:?}");
         }
     }
 
     #[test]
     fn triangle_parallel_behind_and_beyond_t_max_miss() {
         let tri = unit_triangle();
-        assert!(tri
-            .intersect(&ray([0.2, 0.2, 0.0], [1.0, 0.0, 0.0]), f32::MAX)
-            .is_none());
-        assert!(tri
-            .intersect(&ray([0.2, 0.2, 1.0], [1.0, 1.0, 0.0]), f32::MAX)
-            .is_none());
-        assert!(tri
-            .intersect(&ray([0.2, 0.2, 1.0], [0.0, 0.0, 1.0]), f32::MAX)
-            .is_none());
-        assert!(tri
-            .intersect(&ray([0.2, 0.2, 1.0], [0.0, 0.0, -1.0]), 0.5)
-            .is_none());
+        assert!(tri.intersect(&ray([0.2, 0.2, 0.0], [1.0, 0.0, 0.0]), f32::MAX).is_none());
+        assert!(tri.intersect(&ray([0.2, 0.2, 1.0], [1.0, 1.0, 0.0]), f32::MAX).is_none());
+        assert!(tri.intersect(&ray([0.2, 0.2, 1.0], [0.0, 0.0, 1.0]), f32::MAX).is_none());
+        assert!(tri.intersect(&ray([0.2, 0.2, 1.0], [0.0, 0.0, -1.0]), 0.5).is_none());
     }
 
     #[test]
@@ -362,58 +355,33 @@ mod tests {
 
     #[test]
     fn sphere_from_outside_inside_tangent_and_behind() {
-        let s = Sphere {
-            center: Vec3::new(0.0, 0.0, 5.0),
-            radius: 1.0,
-        };
-        let h = s
-            .intersect(&ray([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]), f32::MAX, None)
-            .unwrap();
+        let s = Sphere { center: Vec3::new(0.0, 0.0, 5.0), radius: 1.0 };
+        let h = s.intersect(&ray([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]), f32::MAX, None).unwrap();
         assert!((h.t - 4.0).abs() < 1e-5 && h.normal.dot(Vec3::Z) < -0.999);
         // From the centre: the far root, normal pointing out along the ray.
-        let h = s
-            .intersect(&ray([0.0, 0.0, 5.0], [1.0, 0.0, 0.0]), f32::MAX, None)
-            .unwrap();
+        let h = s.intersect(&ray([0.0, 0.0, 5.0], [1.0, 0.0, 0.0]), f32::MAX, None).unwrap();
         assert!((h.t - 1.0).abs() < 1e-6 && h.normal.dot(Vec3::X) > 0.999);
         // Tangent: touches at x = 1 exactly.
-        let h = s
-            .intersect(&ray([1.0, -3.0, 5.0], [0.0, 1.0, 0.0]), f32::MAX, None)
-            .unwrap();
+        let h = s.intersect(&ray([1.0, -3.0, 5.0], [0.0, 1.0, 0.0]), f32::MAX, None).unwrap();
         assert!((h.t - 3.0).abs() < 1e-3 && (h.point - Vec3::new(1.0, 0.0, 5.0)).length() < 1e-3);
         // Just past tangent: a miss.
-        assert!(s
-            .intersect(&ray([1.001, -3.0, 5.0], [0.0, 1.0, 0.0]), f32::MAX, None)
-            .is_none());
+        assert!(s.intersect(&ray([1.001, -3.0, 5.0], [0.0, 1.0, 0.0]), f32::MAX, None).is_none());
         // Behind the origin.
-        assert!(s
-            .intersect(&ray([0.0, 0.0, 0.0], [0.0, 0.0, -1.0]), f32::MAX, None)
-            .is_none());
+        assert!(s.intersect(&ray([0.0, 0.0, 0.0], [0.0, 0.0, -1.0]), f32::MAX, None).is_none());
         // Zero radius is never hit.
-        let dot = Sphere {
-            center: Vec3::ZERO,
-            radius: 0.0,
-        };
-        assert!(dot
-            .intersect(&ray([0.0, 0.0, -1.0], [0.0, 0.0, 1.0]), f32::MAX, None)
-            .is_none());
+        let dot = Sphere { center: Vec3::ZERO, radius: 0.0 };
+        assert!(dot.intersect(&ray([0.0, 0.0, -1.0], [0.0, 0.0, 1.0]), f32::MAX, None).is_none());
     }
 
     #[test]
     fn sphere_departure_rules() {
-        let s = Sphere {
-            center: Vec3::ZERO,
-            radius: 2.0,
-        };
+        let s = Sphere { center: Vec3::ZERO, radius: 2.0 };
         let on = Vec3::new(0.0, 0.0, 2.0);
         // Leaving inwards: only the far side, at the chord length.
-        let h = s
-            .intersect(&Ray::new(on, -Vec3::Z), f32::MAX, Some(false))
-            .unwrap();
+        let h = s.intersect(&Ray::new(on, -Vec3::Z), f32::MAX, Some(false)).unwrap();
         assert!((h.t - 4.0).abs() < 1e-5);
         // Leaving outwards, even straight back through: nothing.
-        assert!(s
-            .intersect(&Ray::new(on, -Vec3::Z), f32::MAX, Some(true))
-            .is_none());
+        assert!(s.intersect(&Ray::new(on, -Vec3::Z), f32::MAX, Some(true)).is_none());
     }
 
     #[test]
@@ -432,17 +400,9 @@ mod tests {
 
     #[test]
     fn disk_hit_and_rim() {
-        let d = Disk {
-            center: Vec3::new(8.0, 0.0, 4.999),
-            normal: -Vec3::Z,
-            radius: 1.0,
-        };
-        assert!(d
-            .intersect(&ray([8.5, 0.5, 0.0], [0.0, 0.0, 1.0]), f32::MAX)
-            .is_some());
-        assert!(d
-            .intersect(&ray([8.8, 0.8, 0.0], [0.0, 0.0, 1.0]), f32::MAX)
-            .is_none());
+        let d = Disk { center: Vec3::new(8.0, 0.0, 4.999), normal: -Vec3::Z, radius: 1.0 };
+        assert!(d.intersect(&ray([8.5, 0.5, 0.0], [0.0, 0.0, 1.0]), f32::MAX).is_some());
+        assert!(d.intersect(&ray([8.8, 0.8, 0.0], [0.0, 0.0, 1.0]), f32::MAX).is_none());
         assert!((d.area() - std::f32::consts::PI).abs() < 1e-6);
     }
 }

@@ -16,11 +16,7 @@ use std::time::Instant;
 /// Photon-mapping renderer (Jensen: caustic and global photon maps, final
 /// gathering) for the TNCG15 hexagonal room with a glass sphere's caustic.
 #[derive(Parser, Debug)]
-#[command(
-    version,
-    about,
-    after_help = "Example: photonmap --photons 1e6 out.exr -o out.png"
-)]
+#[command(version, about, after_help = "Example: photonmap --photons 1e6 out.exr -o out.png")]
 struct Cli {
     /// Output images; the extension picks the format: .exr (linear float
     /// radiance), .png or .ppm (8-bit, tone-mapped).
@@ -96,10 +92,7 @@ struct Cli {
 
 /// A photon count: an integer written plainly or in e-notation.
 fn parse_count(s: &str) -> Result<u64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{s}' is not a number (try 1e6 or 250000)"))?;
+    let v: f64 = s.trim().parse().map_err(|_| format!("'{s}' is not a number (try 1e6 or 250000)"))?;
     if !v.is_finite() || v < 0.0 {
         return Err(format!("'{s}' must be zero or a positive count"));
     }
@@ -141,16 +134,9 @@ fn main() -> ExitCode {
 }
 
 fn run(cli: Cli) -> Result<(), Error> {
-    let outputs: Vec<PathBuf> = cli
-        .outputs
-        .iter()
-        .chain(&cli.more_outputs)
-        .cloned()
-        .collect();
+    let outputs: Vec<PathBuf> = cli.outputs.iter().chain(&cli.more_outputs).cloned().collect();
     if outputs.is_empty() {
-        return Err(Error::Invalid(
-            "no output file given (e.g. photonmap out.exr)".into(),
-        ));
+        return Err(Error::Invalid("no output file given (e.g. photonmap out.exr)".into()));
     }
     // Every output path is checked before any time is spent rendering.
     for path in &outputs {
@@ -228,21 +214,10 @@ fn run(cli: Cli) -> Result<(), Error> {
     Ok(())
 }
 
-fn summary(
-    s: &Stats,
-    settings: &Settings,
-    write_time: std::time::Duration,
-    total: std::time::Duration,
-) {
+fn summary(s: &Stats, settings: &Settings, write_time: std::time::Duration, total: std::time::Duration) {
     let mrays = |rays: u64, d: std::time::Duration| rays as f64 / d.as_secs_f64().max(1e-9) / 1e6;
-    eprintln!(
-        "photonmap summary ({} threads)",
-        rayon::current_num_threads()
-    );
-    eprintln!(
-        "  global map:  {:>10} photons emitted, {:>10} stored",
-        s.global_emitted, s.global_stored
-    );
+    eprintln!("photonmap summary ({} threads)", rayon::current_num_threads());
+    eprintln!("  global map:  {:>10} photons emitted, {:>10} stored", s.global_emitted, s.global_stored);
     eprintln!(
         "  caustic map: {:>10} photons emitted, {:>10} stored ({:.1}% first hit mirror/glass)",
         s.caustic_emitted,
@@ -264,10 +239,7 @@ fn summary(
         (s.global_emitted + s.caustic_emitted) as f64 / s.photon_time.as_secs_f64().max(1e-9) / 1e6,
         mrays(s.photon_rays, s.photon_time)
     );
-    eprintln!(
-        "  map build    {:>8.3} s  (kd-trees + irradiance cache)",
-        s.build_time.as_secs_f64()
-    );
+    eprintln!("  map build    {:>8.3} s  (kd-trees + irradiance cache)", s.build_time.as_secs_f64());
     eprintln!(
         "  camera pass  {:>8.3} s  {:>7.2} M rays/s  ({} x {}, {} spp, {} gather rays, {} shadow rays)",
         s.camera_time.as_secs_f64(),

@@ -82,24 +82,14 @@ impl PhotonIntegrator<'_> {
         self.trace(ray, None, 0, part, ctx)
     }
 
-    fn trace(
-        &self,
-        ray: Ray,
-        departure: Option<Departure>,
-        depth: u32,
-        part: Part,
-        ctx: &mut Context,
-    ) -> Color {
+    fn trace(&self, ray: Ray, departure: Option<Departure>, depth: u32, part: Part, ctx: &mut Context) -> Color {
         ctx.tally.rays += 1;
         let Some(hit) = self.scene.intersect(&ray, departure) else {
             return Color::ZERO;
         };
         match *self.scene.material(hit.prim) {
             Material::Emitter if part == Part::Reflected => Color::ZERO,
-            Material::Emitter => self
-                .scene
-                .light_of(hit.prim)
-                .map_or(Color::ZERO, |l| l.radiance_towards(ray.dir)),
+            Material::Emitter => self.scene.light_of(hit.prim).map_or(Color::ZERO, |l| l.radiance_towards(ray.dir)),
             Material::Lambertian { rho } => {
                 if max_component(rho) <= 0.0 || part == Part::Emitted {
                     return Color::ZERO;
@@ -117,9 +107,7 @@ impl PhotonIntegrator<'_> {
                     return Color::ZERO;
                 }
                 let frame = Frame::from_normal(hit.facing_normal(ray.dir));
-                let wo = frame
-                    .to_world(reflect(frame.to_local(-ray.dir)))
-                    .normalize();
+                let wo = frame.to_world(reflect(frame.to_local(-ray.dir))).normalize();
                 let (next, dep) = hit.spawn(wo);
                 reflectance * self.trace(next, Some(dep), depth + 1, part, ctx)
             }
@@ -176,10 +164,7 @@ impl PhotonIntegrator<'_> {
                 let (shadow, dep) = hit.spawn(w);
                 ctx.tally.rays += 1;
                 let t_max = (sample.point - shadow.origin).length();
-                if self
-                    .scene
-                    .occluded(&shadow, Some(dep), t_max, Some(light.prim))
-                {
+                if self.scene.occluded(&shadow, Some(dep), t_max, Some(light.prim)) {
                     continue;
                 }
                 light_sum += light.radiance * (cos_x * cos_l / (dist2 * sample.pdf_area));
@@ -194,14 +179,7 @@ impl PhotonIntegrator<'_> {
         if self.caustic.is_empty() {
             return Color::ZERO;
         }
-        self.caustic.radiance_cone(
-            hit.point,
-            n,
-            rho,
-            self.settings.k_caustic,
-            self.settings.r_caustic,
-            ctx.scratch,
-        )
+        self.caustic.radiance_cone(hit.point, n, rho, self.settings.k_caustic, self.settings.r_caustic, ctx.scratch)
     }
 
     /// Light → … diffuse y → (specular*) → x: final gathering.
@@ -213,9 +191,7 @@ impl PhotonIntegrator<'_> {
         let frame = Frame::from_normal(n);
         let mut sum = Color::ZERO;
         for g in 0..count {
-            let dir = frame
-                .to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(ctx.rng))))
-                .normalize();
+            let dir = frame.to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(ctx.rng)))).normalize();
             let (mut ray, mut dep) = hit.spawn(dir);
             let mut weight = Color::ONE;
             for _ in 0..MAX_SPECULAR_DEPTH {
@@ -255,18 +231,12 @@ impl PhotonIntegrator<'_> {
     }
 
     fn checked(&self, c: Color, estimator: &'static str, ctx: &mut Context) -> Color {
-        debug_assert!(
-            c.is_finite(),
-            "{estimator} estimate {c} at pixel {}",
-            ctx.pixel
-        );
+        debug_assert!(c.is_finite(), "{estimator} estimate {c} at pixel {}", ctx.pixel);
         if c.is_finite() {
             c
         } else {
             ctx.tally.nonfinite += 1;
-            ctx.tally
-                .first_nonfinite
-                .get_or_insert((ctx.pixel, estimator));
+            ctx.tally.first_nonfinite.get_or_insert((ctx.pixel, estimator));
             Color::ZERO
         }
     }
@@ -289,11 +259,6 @@ pub fn glass_branches(hit: &Hit, ray: &Ray, ior: f32) -> GlassBranches {
     let (n_i, n_t) = if entering { (1.0, ior) } else { (ior, 1.0) };
     let fresnel = fresnel_dielectric(wi.z, n_i, n_t);
     let reflected = frame.to_world(reflect(wi)).normalize();
-    let refracted =
-        refract(wi, n_i / n_t).map(|wt| (frame.to_world(wt).normalize(), (n_i / n_t).powi(2)));
-    GlassBranches {
-        fresnel: if refracted.is_some() { fresnel } else { 1.0 },
-        reflected,
-        refracted,
-    }
+    let refracted = refract(wi, n_i / n_t).map(|wt| (frame.to_world(wt).normalize(), (n_i / n_t).powi(2)));
+    GlassBranches { fresnel: if refracted.is_some() { fresnel } else { 1.0 }, reflected, refracted }
 }

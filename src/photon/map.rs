@@ -7,7 +7,7 @@
 //! distances are unchanged by a rotation. Photons are stored in Morton order
 //! so that neighbours in space are neighbours in memory.
 
-use super::{oct_decode, oct_encode, Photon};
+use super::{quantize_normal, Photon};
 use crate::math::Color;
 use glam::{EulerRot, Mat3, Vec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
@@ -43,21 +43,14 @@ impl PointTree {
         let rot = rotation();
         let pts: Vec<[f32; 3]> = points.map(|p| (rot * p).to_array()).collect();
         // An empty map has no tree; queries on it find nothing.
-        let tree = if pts.is_empty() {
-            None
-        } else {
-            ImmutableKdTree::new_from_slice(&pts).ok()
-        };
+        let tree = if pts.is_empty() { None } else { ImmutableKdTree::new_from_slice(&pts).ok() };
         PointTree { tree, rot }
     }
 
     /// (squared distance, index) of the nearest point, if any.
     fn nearest(&self, x: Vec3) -> Option<(f32, u32)> {
         self.tree.as_ref().map(|tree| {
-            let n = tree
-                .query(&(self.rot * x).to_array())
-                .nearest_one::<SquaredEuclidean<f32>>()
-                .execute();
+            let n = tree.query(&(self.rot * x).to_array()).nearest_one::<SquaredEuclidean<f32>>().execute();
             (n.distance, n.item)
         })
     }
@@ -73,25 +66,32 @@ impl PointTree {
     }
 }
 
-/// Sorts photons along a Morton curve over their bounds (stable, so the
-/// order is deterministic).
-fn morton_sort(photons: &mut [Photon]) {
-    let (lo, hi) = photons.iter().fold(
-        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-        |(lo, hi), p| (lo.min(p.position()), hi.max(p.position())),
-    );
+/// Sorts photons along a Morton curve over their bounds. Keys carry the
+/// original index in their low bits, so they are unique and the order is
+/// deterministic with a fast unstable sort.
+fn morton_sort(photons: &mut Vec<Photon>) {
+    let (lo, hi) = photons.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| {
+        (lo.min(p.position()), hi.max(p.position()))
+    });
     let scale = 1023.0 / (hi - lo).max(Vec3::splat(f32::MIN_POSITIVE));
-    let spread = |mut v: u32| {
+    let spread = |mut v: u64| {
         v &= 0x3FF;
         v = (v | (v << 16)) & 0x0300_00FF;
         v = (v | (v << 8)) & 0x0300_F00F;
         v = (v | (v << 4)) & 0x030C_30C3;
         (v | (v << 2)) & 0x0924_9249
     };
-    photons.par_sort_by_key(|p| {
-        let q = ((p.position() - lo) * scale).as_uvec3();
-        spread(q.x) | (spread(q.y) << 1) | (spread(q.z) << 2)
-    });
+    let mut keys: Vec<u64> = photons
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let q = ((p.position() - lo) * scale).as_uvec3();
+            let code = spread(q.x as u64) | (spread(q.y as u64) << 1) | (spread(q.z as u64) << 2);
+            (code << 32) | i as u64
+        })
+        .collect();
+    keys.par_sort_unstable();
+    *photons = keys.par_iter().map(|k| photons[(k & 0xFFFF_FFFF) as usize]).collect();
 }
 
 /// A photon map: the photons and a kd-tree over their positions.
@@ -138,23 +138,12 @@ impl PhotonMap {
     /// when fewer than `k` were found (a fixed-radius estimate). Photons on
     /// other surfaces (a wall in a corner) take part in fixing the radius but
     /// add no flux: the disk is the surface's own.
-    pub fn gather(
-        &self,
-        x: Vec3,
-        n: Vec3,
-        k: usize,
-        r_max: f32,
-        scratch: &mut Scratch,
-    ) -> Gathered {
+    pub fn gather(&self, x: Vec3, n: Vec3, k: usize, r_max: f32, scratch: &mut Scratch) -> Gathered {
         let r_max2 = r_max * r_max;
         let buf = &mut scratch.buf;
         // Search a growing radius from the hint: the result is the same as one
         // search at r_max, at the cost of the photons near the answer only.
-        let mut r2 = if scratch.hint_r2 > 0.0 {
-            scratch.hint_r2.min(r_max2)
-        } else {
-            r_max2 * 1e-4
-        };
+        let mut r2 = if scratch.hint_r2 > 0.0 { scratch.hint_r2.min(r_max2) } else { r_max2 * 1e-4 };
         loop {
             buf.clear();
             self.tree.within(x, r2, buf);
@@ -172,55 +161,30 @@ impl PhotonMap {
         };
         scratch.hint_r2 = if r2 < r_max2 { r2 * 1.5 } else { r_max2 };
         buf.retain(|&(_, i)| self.photons[i as usize].surface_normal().dot(n) >= NORMAL_COSINE);
-        Gathered {
-            r2,
-            count: buf.len(),
-        }
+        Gathered { r2, count: buf.len() }
     }
 
     /// Irradiance at `x` with a box kernel: sum of flux / (pi r^2).
-    pub fn irradiance(
-        &self,
-        x: Vec3,
-        n: Vec3,
-        k: usize,
-        r_max: f32,
-        buf: &mut Scratch,
-    ) -> (Color, f32) {
+    pub fn irradiance(&self, x: Vec3, n: Vec3, k: usize, r_max: f32, buf: &mut Scratch) -> (Color, f32) {
         let g = self.gather(x, n, k, r_max, buf);
         if g.count == 0 || !(g.r2 > 0.0) {
             return (Color::ZERO, g.r2);
         }
-        let flux: Color = buf
-            .buf
-            .iter()
-            .map(|&(_, i)| self.photons[i as usize].flux())
-            .sum();
+        let flux: Color = buf.buf.iter().map(|&(_, i)| self.photons[i as usize].flux()).sum();
         (flux / (PI * g.r2), g.r2)
     }
 
     /// Radiance reflected by a Lambertian surface of reflectance `rho`,
     /// estimated with Jensen's cone filter (k = 1: weight 1 - d / r,
     /// normalised by 1 / (1 - 2/3)), which keeps caustic edges sharp.
-    pub fn radiance_cone(
-        &self,
-        x: Vec3,
-        n: Vec3,
-        rho: Color,
-        k: usize,
-        r_max: f32,
-        buf: &mut Scratch,
-    ) -> Color {
+    pub fn radiance_cone(&self, x: Vec3, n: Vec3, rho: Color, k: usize, r_max: f32, buf: &mut Scratch) -> Color {
         let g = self.gather(x, n, k, r_max, buf);
         if g.count == 0 || !(g.r2 > 0.0) {
             return Color::ZERO;
         }
         let r = g.r2.sqrt();
-        let flux: Color = buf
-            .buf
-            .iter()
-            .map(|&(d2, i)| self.photons[i as usize].flux() * (1.0 - d2.sqrt() / r).max(0.0))
-            .sum();
+        let flux: Color =
+            buf.buf.iter().map(|&(d2, i)| self.photons[i as usize].flux() * (1.0 - d2.sqrt() / r).max(0.0)).sum();
         rho / PI * flux * 3.0 / (PI * g.r2)
     }
 }
@@ -238,7 +202,13 @@ pub struct IrradianceCache {
 #[derive(Clone, Copy, Debug)]
 struct CachePoint {
     irradiance: [f32; 3],
-    normal: u32,
+    normal: [i8; 4],
+}
+
+impl CachePoint {
+    fn faces(&self, n: Vec3) -> bool {
+        Vec3::new(self.normal[0] as f32, self.normal[1] as f32, self.normal[2] as f32).dot(n) >= NORMAL_COSINE * 127.0
+    }
 }
 
 impl IrradianceCache {
@@ -253,14 +223,7 @@ impl IrradianceCache {
             .map_init(Scratch::default, |buf, p| {
                 let n = p.surface_normal();
                 let (e, r2) = map.irradiance(p.position(), n, k, r_max, buf);
-                (
-                    p.position(),
-                    CachePoint {
-                        irradiance: e.to_array(),
-                        normal: oct_encode(n),
-                    },
-                    r2,
-                )
+                (p.position(), CachePoint { irradiance: e.to_array(), normal: quantize_normal(n) }, r2)
             })
             .collect();
         // Search as far as twice the median estimate radius: far enough to
@@ -275,11 +238,7 @@ impl IrradianceCache {
             (4.0 * median).min(r_max * r_max)
         };
         let tree = PointTree::build(computed.par_iter().map(|c| c.0));
-        IrradianceCache {
-            points: computed.into_iter().map(|c| c.1).collect(),
-            tree,
-            lookup_r2,
-        }
+        IrradianceCache { points: computed.into_iter().map(|c| c.1).collect(), tree, lookup_r2 }
     }
 
     pub fn len(&self) -> usize {
@@ -297,10 +256,7 @@ impl IrradianceCache {
         // edges and corners is a wider search needed.
         match self.tree.nearest(x) {
             None => return Color::ZERO,
-            Some((d2, i))
-                if d2 <= self.lookup_r2
-                    && oct_decode(self.points[i as usize].normal).dot(n) >= NORMAL_COSINE =>
-            {
+            Some((d2, i)) if d2 <= self.lookup_r2 && self.points[i as usize].faces(n) => {
                 return Vec3::from(self.points[i as usize].irradiance);
             }
             _ => {}
@@ -310,15 +266,11 @@ impl IrradianceCache {
         self.tree.within(x, self.lookup_r2, buf);
         let mut best: Option<(f32, u32)> = None;
         for &(d2, i) in buf.iter() {
-            if best.is_none_or(|b| d2 < b.0)
-                && oct_decode(self.points[i as usize].normal).dot(n) >= NORMAL_COSINE
-            {
+            if best.is_none_or(|b| d2 < b.0) && self.points[i as usize].faces(n) {
                 best = Some((d2, i));
             }
         }
-        best.map_or(Color::ZERO, |(_, i)| {
-            Vec3::from(self.points[i as usize].irradiance)
-        })
+        best.map_or(Color::ZERO, |(_, i)| Vec3::from(self.points[i as usize].irradiance))
     }
 }
 
@@ -337,12 +289,7 @@ mod tests {
         let photons: Vec<Photon> = (0..n)
             .map(|_| {
                 let u = next_2d(&mut rng) * side;
-                Photon::new(
-                    Vec3::new(u.x, u.y, 0.0),
-                    Color::splat(power),
-                    Vec3::Z,
-                    Vec3::Z,
-                )
+                Photon::new(Vec3::new(u.x, u.y, 0.0), Color::splat(power), Vec3::Z, Vec3::Z)
             })
             .collect();
         let map = PhotonMap::build(photons);
@@ -352,39 +299,20 @@ mod tests {
         let mut cone_sum = 0.0;
         let queries = 400;
         for q in 0..queries {
-            let x = Vec3::new(
-                2.0 + 6.0 * (q % 20) as f32 / 20.0,
-                2.0 + 6.0 * (q / 20) as f32 / 20.0,
-                0.0,
-            );
+            let x = Vec3::new(2.0 + 6.0 * (q % 20) as f32 / 20.0, 2.0 + 6.0 * (q / 20) as f32 / 20.0, 0.0);
             box_sum += map.irradiance(x, Vec3::Z, 200, 1.0, &mut buf).0.x;
-            cone_sum += map
-                .radiance_cone(x, Vec3::Z, Color::splat(PI), 200, 1.0, &mut buf)
-                .x;
+            cone_sum += map.radiance_cone(x, Vec3::Z, Color::splat(PI), 200, 1.0, &mut buf).x;
         }
         let (box_mean, cone_mean) = (box_sum / queries as f32, cone_sum / queries as f32);
         // k-NN with the k-th photon on the rim overestimates by k / (k - 1);
         // both means must be within 1.5% of the truth.
-        assert!(
-            (box_mean / exact - 1.0).abs() < 0.015,
-            "box {box_mean} vs {exact}"
-        );
-        assert!(
-            (cone_mean / exact - 1.0).abs() < 0.015,
-            "cone {cone_mean} vs {exact}"
-        );
+        assert!((box_mean / exact - 1.0).abs() < 0.015, "box {box_mean} vs {exact}");
+        assert!((cone_mean / exact - 1.0).abs() < 0.015, "cone {cone_mean} vs {exact}");
         // Photons facing away (other surface) are ignored.
-        assert_eq!(
-            map.irradiance(Vec3::new(5.0, 5.0, 0.0), -Vec3::Z, 50, 1.0, &mut buf)
-                .0,
-            Color::ZERO
-        );
+        assert_eq!(map.irradiance(Vec3::new(5.0, 5.0, 0.0), -Vec3::Z, 50, 1.0, &mut buf).0, Color::ZERO);
         // An empty map answers zero.
         let empty = PhotonMap::build(Vec::new());
-        assert_eq!(
-            empty.irradiance(Vec3::ZERO, Vec3::Z, 10, 1.0, &mut buf).0,
-            Color::ZERO
-        );
+        assert_eq!(empty.irradiance(Vec3::ZERO, Vec3::Z, 10, 1.0, &mut buf).0, Color::ZERO);
     }
 
     #[test]

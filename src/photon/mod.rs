@@ -23,8 +23,9 @@ pub struct Photon {
     /// Flux carried (per channel).
     pub power: [f32; 3],
     /// Surface normal at the hit, turned towards the side the photon arrived
-    /// from (octahedral, 2 x 16 bits): estimates skip photons on other surfaces.
-    pub normal: u32,
+    /// from, as three signed bytes (n * 127): estimates skip photons on
+    /// other surfaces, a test that needs no precision but must be cheap.
+    pub normal: [i8; 4],
     /// Direction towards where the photon came from (octahedral), for
     /// non-Lambertian BRDFs.
     pub dir: u32,
@@ -35,7 +36,7 @@ impl Photon {
         Photon {
             pos: pos.to_array(),
             power: power.to_array(),
-            normal: oct_encode(normal),
+            normal: quantize_normal(normal),
             dir: oct_encode(towards_source),
         }
     }
@@ -49,8 +50,14 @@ impl Photon {
     }
 
     pub fn surface_normal(&self) -> Vec3 {
-        oct_decode(self.normal)
+        Vec3::new(self.normal[0] as f32, self.normal[1] as f32, self.normal[2] as f32) / 127.0
     }
+}
+
+/// A unit normal in three signed bytes (angle error below 0.5 degrees).
+pub fn quantize_normal(n: Vec3) -> [i8; 4] {
+    let q = (n * 127.0).round().clamp(Vec3::splat(-127.0), Vec3::splat(127.0));
+    [q.x as i8, q.y as i8, q.z as i8, 0]
 }
 
 /// Octahedral encoding of a unit vector into two signed 16-bit values
@@ -74,11 +81,7 @@ pub fn oct_decode(e: u32) -> Vec3 {
     let x = (e & 0xFFFF) as u16 as i16 as f32 / 32767.0;
     let y = (e >> 16) as u16 as i16 as f32 / 32767.0;
     let z = 1.0 - x.abs() - y.abs();
-    let (x, y) = if z < 0.0 {
-        ((1.0 - y.abs()) * x.signum(), (1.0 - x.abs()) * y.signum())
-    } else {
-        (x, y)
-    };
+    let (x, y) = if z < 0.0 { ((1.0 - y.abs()) * x.signum(), (1.0 - x.abs()) * y.signum()) } else { (x, y) };
     Vec3::new(x, y, z).normalize_or_zero()
 }
 

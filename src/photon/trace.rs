@@ -10,9 +10,7 @@ use super::Photon;
 use crate::material::Material;
 use crate::math::{max_component, Color, Frame, Ray};
 use crate::optics::{fresnel_dielectric, reflect, refract};
-use crate::sampling::{
-    cosine_hemisphere, next_2d, stream, uniform_cone, uniform_cone_pdf, Domain, Rng,
-};
+use crate::sampling::{cosine_hemisphere, next_2d, stream, uniform_cone, uniform_cone_pdf, Domain, Rng};
 use crate::scene::Scene;
 use crate::shape::Departure;
 use glam::Vec3;
@@ -48,17 +46,8 @@ pub struct PassOutput {
 
 /// Traces `n` photons of `pass`; `on_block` is told the number of photons
 /// done after each block (for progress bars).
-pub fn trace_pass(
-    scene: &Scene,
-    pass: Pass,
-    n: u64,
-    seed: u64,
-    on_block: &(dyn Fn(u64) + Sync),
-) -> PassOutput {
-    if n == 0
-        || scene.lights.is_empty()
-        || (pass == Pass::Caustic && scene.specular_targets().is_empty())
-    {
+pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn Fn(u64) + Sync)) -> PassOutput {
+    if n == 0 || scene.lights.is_empty() || (pass == Pass::Caustic && scene.specular_targets().is_empty()) {
         return PassOutput::default();
     }
     let rays = AtomicU64::new(0);
@@ -111,10 +100,7 @@ fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> Option<(Ray, Depart
         }
     }
     let p_light = max_component(light.power()) / total;
-    let departure = Departure {
-        prim: light.prim,
-        outward: true,
-    };
+    let departure = Departure { prim: light.prim, outward: true };
     match pass {
         Pass::Global => {
             // Uniform position, cosine direction: each photon carries power / n.
@@ -127,12 +113,9 @@ fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> Option<(Ray, Depart
             // pdf_w being the mixture over all cones that contain the direction.
             let targets = scene.specular_targets();
             let origin = light.sample_point(next_2d(rng)).point;
-            let chosen = &targets
-                [((rng.random::<f32>() * targets.len() as f32) as usize).min(targets.len() - 1)];
+            let chosen = &targets[((rng.random::<f32>() * targets.len() as f32) as usize).min(targets.len() - 1)];
             let (axis, cos_max) = cone_towards(origin, chosen.center, chosen.radius);
-            let dir = Frame::from_normal(axis)
-                .to_world(uniform_cone(next_2d(rng), cos_max))
-                .normalize();
+            let dir = Frame::from_normal(axis).to_world(uniform_cone(next_2d(rng), cos_max)).normalize();
             let cos_emit = dir.dot(light.disk.normal);
             if !(cos_emit > 0.0) {
                 return None;
@@ -184,10 +167,7 @@ fn follow(
 ) -> Followed {
     let mut only_specular_so_far = true;
     let mut specular_bounces = 0u32;
-    let mut result = Followed {
-        rays: 0,
-        first_hit_specular: false,
-    };
+    let mut result = Followed { rays: 0, first_hit_specular: false };
     for bounce in 0..MAX_BOUNCES {
         result.rays += 1;
         let Some(hit) = scene.intersect(&ray, Some(departure)) else {
@@ -207,8 +187,7 @@ fn follow(
                     // not a caustic (shadow rays count it); after a diffuse
                     // bounce it is indirect light (final gathering counts it).
                     Pass::Caustic => {
-                        if only_specular_so_far && specular_bounces > 0 && max_component(rho) > 0.0
-                        {
+                        if only_specular_so_far && specular_bounces > 0 && max_component(rho) > 0.0 {
                             out.push(Photon::new(hit.point, power, n, -ray.dir));
                         }
                         break;
@@ -285,10 +264,7 @@ mod tests {
         let out = trace_pass(&scene, Pass::Global, n, 3, &|_| {});
         let phi = scene.emitted_power().x;
         let first = phi / n as f32;
-        assert!(out
-            .photons
-            .iter()
-            .any(|p| (p.power[0] - first).abs() < 1e-6 * first));
+        assert!(out.photons.iter().any(|p| (p.power[0] - first).abs() < 1e-6 * first));
         let total: f64 = out.photons.iter().map(|p| p.power[0] as f64).sum();
         // Every emitted photon lands somewhere first (closed room): total > 0.9 Phi.
         assert!(total > 0.9 * phi as f64, "{total}");
