@@ -55,7 +55,7 @@ impl Default for Settings {
             k_caustic: 100,
             r_global: None,
             r_caustic: None,
-            gather_rays: 16,
+            gather_rays: 4,
             shadow_rays: 2,
             cache_stride: 4,
             edge_spp: 256,

@@ -16,7 +16,12 @@ use std::time::Instant;
 /// Photon-mapping renderer (Jensen: caustic and global photon maps, final
 /// gathering) for the TNCG15 hexagonal room with a glass sphere's caustic.
 #[derive(Parser, Debug)]
-#[command(version, about, after_help = "Example: photonmap --photons 1e6 out.exr -o out.png")]
+#[command(
+    version,
+    about,
+    allow_negative_numbers = true,
+    after_help = "Example: photonmap --photons 1e6 out.exr -o out.png"
+)]
 struct Cli {
     /// Output images; the extension picks the format: .exr (linear float
     /// radiance), .png or .ppm (8-bit, tone-mapped).
@@ -65,7 +70,7 @@ struct Cli {
     #[arg(long, value_parser = parse_radius)]
     caustic_radius: Option<f32>,
     /// Final-gather rays per diffuse camera hit (0: no indirect light).
-    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(0..=65_536))]
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=65_536))]
     gather_rays: u32,
     /// Shadow rays per light per diffuse camera hit.
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=65_536))]

@@ -161,6 +161,10 @@ impl PhotonMap {
         };
         scratch.hint_r2 = if r2 < r_max2 { r2 * 1.5 } else { r_max2 };
         buf.retain(|&(_, i)| self.photons[i as usize].surface_normal().dot(n) >= NORMAL_COSINE);
+        // The visit order depends on the radius searched, hence on the hint,
+        // hence on which thread ran the previous query: sum in photon order so
+        // the last bits of an estimate do not depend on the thread count.
+        buf.sort_unstable_by_key(|e| e.1);
         Gathered { r2, count: buf.len() }
     }
 

@@ -1,0 +1,131 @@
+//! The `photonmap` command: what a user types, what they get back.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn photonmap(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_photonmap")).args(args).output().expect("run photonmap")
+}
+
+fn scratch_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+const TINY: &[&str] = &["--width", "24", "--height", "24", "--spp", "1", "--quiet"];
+
+#[test]
+fn renders_exr_png_and_ppm_in_one_run() {
+    let dir = scratch_dir("cli-outputs");
+    let (exr, png, ppm) = (dir.join("a.exr"), dir.join("a.png"), dir.join("a.ppm"));
+    let mut args = vec!["--photons", "2.5e3", "--caustic-photons", "1000", exr.to_str().unwrap()];
+    args.extend(["-o", png.to_str().unwrap(), "--output", ppm.to_str().unwrap()]);
+    args.extend(TINY);
+    let o = photonmap(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let film = photonmap::output::read_exr(&exr).unwrap();
+    assert_eq!((film.width, film.height), (24, 24));
+    assert!(film.mean() > 0.0 && film.pixels.iter().all(|c| c.is_finite()));
+    let img = image::open(&png).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (24, 24));
+    // Linear tone mapping: the brightest channel maps to 255.
+    assert_eq!(img.pixels().flat_map(|p| p.0).max(), Some(255));
+    assert_eq!(image::open(&ppm).unwrap().to_rgb8(), img);
+    // No temporary files are left behind.
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 3);
+}
+
+#[test]
+fn photon_counts_accept_plain_and_e_notation() {
+    for ok in ["1000000", "1e6", "2.5e5", "0"] {
+        let o = photonmap(&["--photons", ok, "--help"]);
+        assert!(o.status.success(), "{ok}: {}", stderr(&o));
+    }
+}
+
+#[test]
+fn bad_flags_fail_with_a_message_and_leave_the_output_alone() {
+    let dir = scratch_dir("cli-bad");
+    let out = dir.join("keep.exr");
+    std::fs::write(&out, b"precious").unwrap();
+    let o = out.to_str().unwrap();
+    let jpg = dir.join("out.jpg");
+    let missing = dir.join("missing/out.exr");
+    let cases: &[(&[&str], &str)] = &[
+        (&["--photons", "abc", o], "not a number"),
+        (&["--photons", "-5", o], "positive"),
+        (&["--photons", "1e99", o], "1e9"),
+        (&["--photons", "1.5", o], "whole number"),
+        (&["--spp", "0", o], "spp"),
+        (&["--eye", "3", o], "eye"),
+        (&["--width", "0", o], "width"),
+        (&["--max-radius", "-1", o], "positive distance"),
+        (&[jpg.to_str().unwrap()], "unknown output extension"),
+        (&[missing.to_str().unwrap()], "does not exist"),
+        (&[], "no output file"),
+    ];
+    for (args, message) in cases {
+        let o = photonmap(args);
+        assert!(!o.status.success(), "{args:?} should fail");
+        assert!(stderr(&o).contains(message), "{args:?}: {}", stderr(&o));
+    }
+    assert_eq!(std::fs::read(&out).unwrap(), b"precious");
+}
+
+#[test]
+fn zero_photons_renders_direct_light_and_warns() {
+    let dir = scratch_dir("cli-zero");
+    let out = dir.join("direct.exr");
+    let o = photonmap(&[
+        "--photons",
+        "0",
+        "--caustic-photons",
+        "0",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("indirect light is missing"));
+    assert!(stderr(&o).contains("caustics are missing"));
+    let film = photonmap::output::read_exr(&out).unwrap();
+    assert!(film.mean() > 0.0);
+}
+
+#[test]
+fn help_documents_every_option_with_its_default() {
+    let o = photonmap(&["--help"]);
+    let help = String::from_utf8_lossy(&o.stdout);
+    for flag in [
+        "--photons",
+        "--caustic-photons",
+        "--spp",
+        "--seed",
+        "--eye",
+        "--threads",
+        "--width",
+        "--height",
+        "--k ",
+        "--k-caustic",
+        "--max-radius",
+        "--caustic-radius",
+        "--gather-rays",
+        "--shadow-rays",
+        "--edge-spp",
+        "--tonemap",
+        "--exposure",
+        "--reference",
+        "--quiet",
+    ] {
+        assert!(help.contains(flag), "--help lacks {flag}");
+    }
+    assert!(help.contains("[default: 1e6]"));
+}
