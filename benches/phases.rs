@@ -1,1 +1,70 @@
-fn main() {}
+//! The renderer's phases on the default scene, one group each:
+//! `cargo bench --bench phases` (figures in notes/performance.md).
+
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
+use photonmap::photon::map::{IrradianceCache, PhotonMap, Scratch};
+use photonmap::photon::trace::{trace_pass, Pass};
+use photonmap::progress::Mode;
+use photonmap::render::{render, Settings};
+use photonmap::scene::{Eye, Scene};
+use std::hint::black_box;
+
+fn photon_pass(c: &mut Criterion) {
+    let scene = Scene::tncg15(Eye::One);
+    let mut g = c.benchmark_group("photon_pass");
+    g.sample_size(10);
+    for (name, pass) in [("global", Pass::Global), ("caustic", Pass::Caustic)] {
+        g.throughput(Throughput::Elements(100_000));
+        g.bench_function(name, |b| b.iter(|| black_box(trace_pass(&scene, pass, 100_000, 1, &|_| {}).photons.len())));
+    }
+    g.finish();
+}
+
+fn kd_tree_build(c: &mut Criterion) {
+    let scene = Scene::tncg15(Eye::One);
+    // About one million stored photons (200k emitted, ~5 diffuse hits each).
+    let photons = trace_pass(&scene, Pass::Global, 200_000, 1, &|_| {}).photons;
+    let mut g = c.benchmark_group("kd_tree_build");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(photons.len() as u64));
+    g.bench_function(format!("{}_photons", photons.len()), |b| {
+        b.iter_batched(|| photons.clone(), |p| black_box(PhotonMap::build(p).len()), BatchSize::LargeInput)
+    });
+    g.finish();
+}
+
+fn radiance_queries(c: &mut Criterion) {
+    let scene = Scene::tncg15(Eye::One);
+    let caustic = PhotonMap::build(trace_pass(&scene, Pass::Caustic, 1_000_000, 1, &|_| {}).photons);
+    let global = PhotonMap::build(trace_pass(&scene, Pass::Global, 200_000, 1, &|_| {}).photons);
+    let cache = IrradianceCache::build(&global, 4, 100, 0.05 * scene.diagonal());
+    // Query points: a line of floor points through the glass sphere's caustic.
+    let queries: Vec<glam::Vec3> =
+        (0..1000).map(|i| glam::Vec3::new(8.0 + 4.0 * i as f32 / 1000.0, -2.5, -5.0)).collect();
+    let n = glam::Vec3::Z;
+    let mut g = c.benchmark_group("radiance_queries");
+    g.throughput(Throughput::Elements(queries.len() as u64));
+    let r = 0.01 * scene.diagonal();
+    g.bench_function("caustic_cone_k100", |b| {
+        let mut s = Scratch::default();
+        b.iter(|| queries.iter().map(|&x| caustic.radiance_cone(x, n, glam::Vec3::ONE, 100, r, &mut s).x).sum::<f32>())
+    });
+    g.bench_function("irradiance_cache_lookup", |b| {
+        let mut s = Scratch::default();
+        b.iter(|| queries.iter().map(|&x| cache.lookup(x, n, &mut s).x).sum::<f32>())
+    });
+    g.finish();
+}
+
+fn full_render(c: &mut Criterion) {
+    let scene = Scene::tncg15(Eye::One);
+    let settings =
+        Settings { photons: 100_000, caustic_photons: 100_000, width: 100, height: 100, ..Settings::default() };
+    let mut g = c.benchmark_group("full_render");
+    g.sample_size(10);
+    g.bench_function("100x100_1e5_photons", |b| b.iter(|| black_box(render(&scene, &settings, Mode::Quiet).0.mean())));
+    g.finish();
+}
+
+criterion_group!(benches, photon_pass, kd_tree_build, radiance_queries, full_render);
+criterion_main!(benches);

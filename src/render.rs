@@ -88,6 +88,9 @@ pub struct Stats {
     pub caustic_stored: usize,
     /// Caustic-pass photons whose first hit was mirror or glass.
     pub caustic_aimed_hits: u64,
+    /// Global-pass photons whose first hit was mirror or glass (what the
+    /// caustic pass would get without aiming).
+    pub global_specular_hits: u64,
     pub cache_points: usize,
     pub map_bytes: usize,
     pub photon_rays: u64,
@@ -117,6 +120,7 @@ pub fn render(scene: &Scene, settings: &Settings, progress: Mode) -> (Film, Stat
     stats.global_emitted = global.emitted;
     stats.caustic_emitted = caustic.emitted;
     stats.caustic_aimed_hits = caustic.first_hit_specular;
+    stats.global_specular_hits = global.first_hit_specular;
     stats.photon_rays = global.rays + caustic.rays;
 
     let t = Instant::now();

@@ -3,18 +3,20 @@
 //!
 //! Bounds, and why (measurements in notes/accuracy.md):
 //! * mean radiance within 2% and the caustic window's mean within 5%: the
-//!   issue's bias requirement; we measure about 0.1% and 1% here;
-//! * RMSE: 200² at 4 spp with 2e5 photons measured 0.0066 to 0.0072 over
-//!   five seeds (the references' own noise is 0.0005); the bound 0.010
-//!   leaves ~40% headroom for noise yet fails if, say, the caustic moves by a
-//!   pixel or indirect light loses 5% (each measured to push RMSE past 0.012).
+//!   issue's bias requirement; five seeds measured within 0.07% and 1.0%;
+//! * RMSE: this CI-sized render (200² at 4 spp, 2e5 + 2e5 photons, 8 gather
+//!   rays) measured 0.0083 to 0.0095 over seeds 1-5 (caustic window 0.035 to
+//!   0.049); the references' own noise is 0.0005. The bounds 0.012 and 0.065
+//!   sit about 25% above the worst seed: room for noise, while a lost light
+//!   path (indirect light at 90%: rmse 0.016) or a caustic moved by one pixel
+//!   fails them.
 
 mod common;
 use common::*;
 use photonmap::scene::{Eye, Scene};
 
-const RMSE_BOUND: f64 = 0.010;
-const CAUSTIC_RMSE_BOUND: f64 = 0.06;
+const RMSE_BOUND: f64 = 0.012;
+const CAUSTIC_RMSE_BOUND: f64 = 0.065;
 
 fn check(eye: Eye, reference_name: &str, label: &str) {
     let scene = Scene::tncg15(eye);

@@ -222,9 +222,14 @@ fn run(cli: Cli) -> Result<(), Error> {
 fn summary(s: &Stats, settings: &Settings, write_time: std::time::Duration, total: std::time::Duration) {
     let mrays = |rays: u64, d: std::time::Duration| rays as f64 / d.as_secs_f64().max(1e-9) / 1e6;
     eprintln!("photonmap summary ({} threads)", rayon::current_num_threads());
-    eprintln!("  global map:  {:>10} photons emitted, {:>10} stored", s.global_emitted, s.global_stored);
     eprintln!(
-        "  caustic map: {:>10} photons emitted, {:>10} stored ({:.1}% first hit mirror/glass)",
+        "  global map:  {:>10} photons emitted, {:>10} stored ({:.1}% first hit mirror/glass)",
+        s.global_emitted,
+        s.global_stored,
+        100.0 * s.global_specular_hits as f64 / s.global_emitted.max(1) as f64
+    );
+    eprintln!(
+        "  caustic map: {:>10} photons emitted, {:>10} stored ({:.1}% first hit mirror/glass: aimed)",
         s.caustic_emitted,
         s.caustic_stored,
         100.0 * s.caustic_aimed_hits as f64 / s.caustic_emitted.max(1) as f64

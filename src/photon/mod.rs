@@ -33,6 +33,7 @@ pub struct Photon {
 
 impl Photon {
     pub fn new(pos: Vec3, power: Color, normal: Vec3, towards_source: Vec3) -> Self {
+        debug_assert!(power.is_finite() && pos.is_finite(), "photon power {power} at {pos}");
         Photon {
             pos: pos.to_array(),
             power: power.to_array(),
