@@ -239,3 +239,80 @@ impl Scene {
         self.lights.iter().map(|l| l.power()).sum()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::{next_2d, stream, uniform_cone, Domain};
+
+    /// Rays spawned from surfaces of the default scene, in both hemispheres
+    /// and at grazing angles, never re-hit their own surface near the origin,
+    /// and a ray leaving the glass sphere inwards meets its far side at the
+    /// chord length.
+    #[test]
+    fn spawned_rays_never_rehit_their_own_surface() {
+        let scene = Scene::tncg15(Eye::One);
+        let mut rng = stream(8, Domain::Camera, 4);
+        let mut checked = 0;
+        for _ in 0..20_000 {
+            let o = Vec3::new(
+                1.0 + 10.0 * next_2d(&mut rng).x,
+                -4.0 + 8.0 * next_2d(&mut rng).x,
+                -4.0 + 8.0 * next_2d(&mut rng).y,
+            );
+            let Some(hit) = scene.intersect(&Ray::new(o, uniform_cone(next_2d(&mut rng), -1.0)), None) else {
+                continue;
+            };
+            for grazing in [false, true] {
+                let mut d = uniform_cone(next_2d(&mut rng), -1.0);
+                if grazing {
+                    // Nearly tangent to the surface, on either side.
+                    d = (d - hit.normal * d.dot(hit.normal) * 0.9999).normalize();
+                }
+                let (ray, dep) = hit.spawn(d);
+                if let Some(next) = scene.intersect(&ray, Some(dep)) {
+                    checked += 1;
+                    if next.prim == hit.prim {
+                        let Shape::Sphere(s) = scene.prims[hit.prim as usize].shape else {
+                            panic!("re-hit flat primitive {} at t = {}", hit.prim, next.t)
+                        };
+                        assert!(!dep.outward, "left a sphere outwards and met it again");
+                        let cos = -d.dot(hit.normal);
+                        let chord = 2.0 * s.radius * cos;
+                        // The origin sits up to |p_err| inside the surface; from
+                        // there a tangent chord is up to sqrt(8 r |p_err|) long.
+                        let slack = (8.0 * s.radius * hit.p_err.length()).sqrt() + 1e-4 * s.radius;
+                        assert!(
+                            (next.t - chord).abs() < slack.max(1e-3 * s.radius * (cos > 0.01) as i32 as f32),
+                            "t {} vs chord {chord} (cos {cos})",
+                            next.t
+                        );
+                        assert!(next.normal.dot(d) >= -1e-3, "the far side is where the ray exits");
+                    }
+                }
+            }
+        }
+        // Half the directions leave the room through the wall they start on.
+        assert!(checked > 15_000, "{checked}");
+    }
+
+    #[test]
+    fn default_scene_is_the_spec() {
+        let scene = Scene::tncg15(Eye::One);
+        // 24 room triangles + glass + mirror + 4 tetrahedron faces + the light.
+        assert_eq!(scene.prims.len(), 31);
+        assert_eq!(scene.lights.len(), 1);
+        let phi = scene.emitted_power();
+        assert!((phi.x - std::f32::consts::PI.powi(2) * 10.0).abs() < 1e-3);
+        // Every room normal points into the room: from the room's centre each
+        // triangle's front faces the centre.
+        for p in &scene.prims[..24] {
+            let Shape::Triangle(t) = p.shape else { panic!() };
+            assert!(t.normal.dot(Vec3::new(5.0, 0.0, 0.0) - t.v0) > 0.0);
+            assert!((t.area() - 0.0).abs() > 1.0);
+        }
+        let (lo, hi) = scene.bounds();
+        assert_eq!((lo, hi), (Vec3::new(-3.0, -6.0, -5.0), Vec3::new(13.0, 6.0, 5.0)));
+        assert_eq!(scene.specular_targets().len(), 2);
+    }
+}
