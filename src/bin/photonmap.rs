@@ -82,8 +82,9 @@ struct Cli {
     /// Tone mapping of 8-bit outputs: linear (255.99 / i_max) or sqrt.
     #[arg(long, value_enum, default_value_t = ToneMap::Linear)]
     tonemap: ToneMap,
-    /// Radiance multiplier applied before tone mapping 8-bit outputs
-    /// (values past the maximum clamp).
+    /// Brightness factor of 8-bit outputs, applied after the tone map's
+    /// normalisation to i_max (values past 255 clip): 4 shows a room that
+    /// the light's own brightness would leave dark.
     #[arg(long, default_value_t = 1.0, value_parser = parse_exposure)]
     exposure: f32,
     /// Score the render against a reference EXR of the default scene (the
