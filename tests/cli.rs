@@ -66,6 +66,8 @@ fn bad_flags_fail_with_a_message_and_leave_the_output_alone() {
         (&["--eye", "3", o], "eye"),
         (&["--width", "0", o], "width"),
         (&["--max-radius", "-1", o], "positive distance"),
+        (&["--photons", "1e9", o], "memory is available"),
+        (&["--width", "65536", "--height", "65536", o], "memory is available"),
         (&[jpg.to_str().unwrap()], "unknown output extension"),
         (&[missing.to_str().unwrap()], "does not exist"),
         (&[], "no output file"),

@@ -171,6 +171,22 @@ fn run(cli: Cli) -> Result<(), Error> {
         edge_spp: cli.edge_spp,
         ..Settings::default()
     };
+    // Refuse before allocating: a map that cannot fit would abort the
+    // process half-way, after minutes of work.
+    if let Some(available) = available_memory() {
+        let need = settings.estimated_peak_bytes();
+        if need > available {
+            return Err(Error::Invalid(format!(
+                "--photons {} / --caustic-photons {} at {}x{} need about {:.1} GB; {:.1} GB of memory is available",
+                settings.photons,
+                settings.caustic_photons,
+                settings.width,
+                settings.height,
+                need as f64 / 1e9,
+                available as f64 / 1e9
+            )));
+        }
+    }
     let scene = Scene::tncg15(if cli.eye == 2 { Eye::Two } else { Eye::One });
     if settings.photons == 0 && !cli.quiet {
         eprintln!("photonmap: warning: --photons 0: no global map, so indirect light is missing");
@@ -218,6 +234,14 @@ fn run(cli: Cli) -> Result<(), Error> {
         );
     }
     Ok(())
+}
+
+/// Memory the system can give this process (Linux: MemAvailable), if known.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }
 
 fn summary(s: &Stats, settings: &Settings, write_time: std::time::Duration, total: std::time::Duration) {
