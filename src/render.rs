@@ -2,8 +2,9 @@
 
 use crate::camera::Camera;
 use crate::film::Film;
-use crate::integrator::photon::{Context, Part, PhotonEstimator, PhotonIntegrator};
-use crate::integrator::Tally;
+use crate::integrator::path::PathIntegrator;
+use crate::integrator::photon::{PhotonEstimator, PhotonIntegrator};
+use crate::integrator::{Context, Integrator, Part, Tally};
 use crate::math::max_component;
 use crate::photon::map::Scratch;
 use crate::photon::map::{IrradianceCache, PhotonMap};
@@ -15,9 +16,20 @@ use glam::DVec3;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
+/// The estimator a render uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Method {
+    /// Photon mapping: direct light, caustic map, final gathering.
+    #[default]
+    Photon,
+    /// Path tracing with next-event estimation (unbiased, the reference).
+    Path,
+}
+
 /// Everything that decides the image besides the scene.
 #[derive(Clone, Copy, Debug)]
 pub struct Settings {
+    pub method: Method,
     /// Photons emitted for the global map.
     pub photons: u64,
     /// Photons emitted (aimed at mirrors and glass) for the caustic map.
@@ -40,11 +52,15 @@ pub struct Settings {
     pub cache_stride: usize,
     /// Samples of the emitted part in pixels on the rim of a light's image.
     pub edge_spp: u32,
+    /// Progressive photon mapping's radius shrinkage (Knaus & Zwicker 2011):
+    /// pass i uses r_i^2 = r_1^2 * prod_{k<i} (k + alpha - 1) / k.
+    pub alpha: f32,
 }
 
 impl Default for Settings {
     fn default() -> Self {
         Settings {
+            method: Method::Photon,
             photons: 1_000_000,
             caustic_photons: 1_000_000,
             spp: 4,
@@ -59,6 +75,7 @@ impl Default for Settings {
             shadow_rays: 2,
             cache_stride: 4,
             edge_spp: 256,
+            alpha: 2.0 / 3.0,
         }
     }
 }
@@ -115,56 +132,278 @@ pub struct Stats {
     pub photon_time: Duration,
     pub build_time: Duration,
     pub camera_time: Duration,
+    /// Radius caps and photons per estimate (of the last pass when progressive).
     pub r_global: f32,
     pub r_caustic: f32,
+    pub k_global: usize,
+    pub k_caustic: usize,
+    /// Passes rendered (1 for a classic render).
+    pub passes: u32,
 }
 
-/// Renders `scene` (its camera at `settings`' resolution) with photon mapping.
-pub fn render(scene: &Scene, settings: &Settings, progress: Mode) -> (Film, Stats) {
-    let mut stats =
-        Stats { r_global: settings.r_global(scene), r_caustic: settings.r_caustic(scene), ..Stats::default() };
+impl Stats {
+    /// Adds another pass's counts and times (maps' sizes are the last pass's).
+    fn absorb(&mut self, o: Stats) {
+        self.global_emitted += o.global_emitted;
+        self.caustic_emitted += o.caustic_emitted;
+        self.caustic_aimed_hits += o.caustic_aimed_hits;
+        self.global_specular_hits += o.global_specular_hits;
+        self.photon_rays += o.photon_rays;
+        self.camera_rays += o.camera_rays;
+        self.nonfinite += o.nonfinite;
+        self.first_nonfinite = self.first_nonfinite.or(o.first_nonfinite);
+        self.photon_time += o.photon_time;
+        self.build_time += o.build_time;
+        self.camera_time += o.camera_time;
+        self.global_stored = o.global_stored;
+        self.caustic_stored = o.caustic_stored;
+        self.cache_points = o.cache_points;
+        self.map_bytes = o.map_bytes;
+        self.edge_pixels = o.edge_pixels;
+        self.r_global = o.r_global;
+        self.r_caustic = o.r_caustic;
+        self.k_global = o.k_global;
+        self.k_caustic = o.k_caustic;
+        self.passes += o.passes;
+    }
+}
 
+/// The density-estimation settings of one photon-mapping pass: k nearest
+/// photons within a radius cap, for the global (irradiance) and caustic maps.
+#[derive(Clone, Copy, Debug)]
+struct Estimates {
+    k_global: usize,
+    k_caustic: usize,
+    r_global: f32,
+    r_caustic: f32,
+}
+
+impl Estimates {
+    fn classic(scene: &Scene, settings: &Settings) -> Self {
+        Estimates {
+            k_global: settings.k_global,
+            k_caustic: settings.k_caustic,
+            r_global: settings.r_global(scene),
+            r_caustic: settings.r_caustic(scene),
+        }
+    }
+
+    /// Pass `i` (0-based) of a progressive render: k and the squared radius
+    /// cap scaled by s_i = prod_{k=1}^{i} (k + alpha - 1) / k. Per pass the
+    /// variance grows as 1 / s_i and the bias shrinks as s_i, so the average
+    /// of n passes has variance ~ n^-alpha and bias ~ n^(alpha-1) (Knaus &
+    /// Zwicker 2011), while each estimate keeps adapting to the local density.
+    /// k stays at least 2 (the estimators use the k-1 photons inside the rim).
+    fn progressive(scene: &Scene, settings: &Settings, pass: u32) -> Self {
+        let s: f64 = (1..=pass).map(|k| (k as f64 + settings.alpha as f64 - 1.0) / k as f64).product();
+        let base = Estimates::classic(scene, settings);
+        let k = |k: usize| ((k as f64 * s).round() as usize).max(2);
+        Estimates {
+            k_global: k(base.k_global),
+            k_caustic: k(base.k_caustic),
+            r_global: base.r_global * s.sqrt() as f32,
+            r_caustic: base.r_caustic * s.sqrt() as f32,
+        }
+    }
+}
+
+/// The maps of one photon-mapping pass. The global map itself is dropped
+/// once its irradiance is cached: the camera pass reads only the cache.
+struct Maps {
+    caustic: PhotonMap,
+    cache: IrradianceCache,
+}
+
+/// Traces the photons of pass `pass` and builds its maps.
+fn photon_pass(
+    scene: &Scene,
+    settings: &Settings,
+    pass: u64,
+    est: Estimates,
+    progress: Mode,
+    stats: &mut Stats,
+) -> Maps {
+    let seed = pass_seed(settings.seed, pass);
     let t = Instant::now();
     let phase = Phase::start(progress, "photon pass", settings.photons + settings.caustic_photons);
-    let global = trace_pass(scene, Pass::Global, settings.photons, settings.seed, &|n| phase.advance(n));
-    let caustic = trace_pass(scene, Pass::Caustic, settings.caustic_photons, settings.seed, &|n| phase.advance(n));
+    let global = trace_pass(scene, Pass::Global, settings.photons, seed, &|n| phase.advance(n));
+    let caustic = trace_pass(scene, Pass::Caustic, settings.caustic_photons, seed, &|n| phase.advance(n));
     phase.finish();
-    stats.photon_time = t.elapsed();
-    stats.global_emitted = global.emitted;
-    stats.caustic_emitted = caustic.emitted;
-    stats.caustic_aimed_hits = caustic.first_hit_specular;
-    stats.global_specular_hits = global.first_hit_specular;
-    stats.photon_rays = global.rays + caustic.rays;
+    stats.photon_time += t.elapsed();
+    stats.global_emitted += global.emitted;
+    stats.caustic_emitted += caustic.emitted;
+    stats.caustic_aimed_hits += caustic.first_hit_specular;
+    stats.global_specular_hits += global.first_hit_specular;
+    stats.photon_rays += global.rays + caustic.rays;
 
     let t = Instant::now();
     let global_map = PhotonMap::build(global.photons);
     let caustic_map = PhotonMap::build(caustic.photons);
-    let cache = IrradianceCache::build(&global_map, settings.cache_stride, settings.k_global, stats.r_global);
-    stats.build_time = t.elapsed();
+    let cache = IrradianceCache::build(&global_map, settings.cache_stride, est.k_global, est.r_global);
+    stats.build_time += t.elapsed();
     stats.global_stored = global_map.len();
     stats.caustic_stored = caustic_map.len();
     stats.cache_points = cache.len();
     stats.map_bytes = global_map.memory_bytes() + caustic_map.memory_bytes();
+    Maps { caustic: caustic_map, cache }
+}
 
-    let integrator = PhotonIntegrator {
+/// The seed of pass `pass`: pass 0 uses the seed itself, so a one-pass
+/// progressive render is the classic render's photon set.
+fn pass_seed(seed: u64, pass: u64) -> u64 {
+    if pass == 0 {
+        seed
+    } else {
+        crate::sampling::splitmix64(seed ^ pass.wrapping_mul(0xA076_1D64_78BD_642F))
+    }
+}
+
+fn photon_integrator<'a>(
+    scene: &'a Scene,
+    settings: &Settings,
+    maps: &'a Maps,
+    est: Estimates,
+) -> PhotonIntegrator<'a> {
+    PhotonIntegrator {
         scene,
-        caustic: &caustic_map,
-        cache: &cache,
+        caustic: &maps.caustic,
+        cache: &maps.cache,
         settings: PhotonEstimator {
-            k_caustic: settings.k_caustic,
-            r_caustic: stats.r_caustic,
+            k_caustic: est.k_caustic,
+            r_caustic: est.r_caustic,
             gather_rays: settings.gather_rays,
             shadow_rays: settings.shadow_rays,
         },
+    }
+}
+
+/// Renders `scene` (its camera at `settings`' resolution) in one pass.
+pub fn render(scene: &Scene, settings: &Settings, progress: Mode) -> (Film, Stats) {
+    let mut stats = Stats {
+        r_global: settings.r_global(scene),
+        r_caustic: settings.r_caustic(scene),
+        k_global: settings.k_global,
+        k_caustic: settings.k_caustic,
+        passes: 1,
+        ..Stats::default()
     };
-    let t = Instant::now();
-    let (film, tally) = camera_pass(scene, settings, &integrator, progress);
-    stats.camera_time = t.elapsed();
+    let (film, tally, camera_time) = match settings.method {
+        Method::Photon => {
+            let est = Estimates::classic(scene, settings);
+            let maps = photon_pass(scene, settings, 0, est, progress, &mut stats);
+            let integrator = photon_integrator(scene, settings, &maps, est);
+            timed(|| camera_pass(scene, settings, &integrator, 0, progress))
+        }
+        Method::Path => {
+            let integrator = PathIntegrator { scene, shadow_rays: settings.shadow_rays };
+            timed(|| camera_pass(scene, settings, &integrator, 0, progress))
+        }
+    };
+    stats.camera_time = camera_time;
     stats.camera_rays = tally.rays;
-    stats.edge_pixels = tally.edge_pixels;
     stats.nonfinite = tally.nonfinite;
     stats.first_nonfinite = tally.first_nonfinite;
+    stats.edge_pixels = tally.edge_pixels;
     (film, stats)
+}
+
+fn timed<T, U>(f: impl FnOnce() -> (T, U)) -> (T, U, Duration) {
+    let t = Instant::now();
+    let (a, b) = f();
+    (a, b, t.elapsed())
+}
+
+/// When a progressive render stops.
+#[derive(Clone, Copy, Debug)]
+pub enum Budget {
+    Passes(u32),
+    /// Wall-clock seconds: no pass starts that the last pass's duration says
+    /// would end past the budget (at least one pass always runs).
+    Seconds(f64),
+}
+
+/// The state of a progressive render after a pass, for progress displays
+/// and periodic output.
+pub struct PassReport<'a> {
+    pub film: &'a Film,
+    pub passes: u32,
+    pub elapsed: Duration,
+    pub r_caustic: f32,
+    pub r_global: f32,
+    pub k_caustic: usize,
+    pub k_global: usize,
+}
+
+/// Progressive rendering: independent passes, each with its own photons (or,
+/// for path tracing, its own camera samples), averaged. Photon mapping's
+/// estimates narrow from pass to pass ([`Estimates::progressive`]), so the
+/// average converges to the true image. `on_pass` sees the running average
+/// after every pass.
+pub fn render_progressive(
+    scene: &Scene,
+    settings: &Settings,
+    budget: Budget,
+    mut on_pass: impl FnMut(&PassReport),
+) -> (Film, Stats) {
+    let start = Instant::now();
+    let (w, h) = (settings.width, settings.height);
+    let mut sum = vec![DVec3::ZERO; w as usize * h as usize];
+    let mut stats = Stats::default();
+    let mut pass = 0u32;
+    let mut last_pass_time = Duration::ZERO;
+    loop {
+        let more = match budget {
+            Budget::Passes(n) => pass < n.max(1),
+            Budget::Seconds(s) => pass == 0 || (start.elapsed() + last_pass_time).as_secs_f64() <= s,
+        };
+        if !more {
+            break;
+        }
+        let t = Instant::now();
+        let mut pass_stats = Stats { passes: 1, ..Stats::default() };
+        let (film, tally, camera_time) = match settings.method {
+            Method::Photon => {
+                let est = Estimates::progressive(scene, settings, pass);
+                pass_stats.r_global = est.r_global;
+                pass_stats.r_caustic = est.r_caustic;
+                pass_stats.k_global = est.k_global;
+                pass_stats.k_caustic = est.k_caustic;
+                let maps = photon_pass(scene, settings, pass as u64, est, Mode::Quiet, &mut pass_stats);
+                let integrator = photon_integrator(scene, settings, &maps, est);
+                timed(|| camera_pass(scene, settings, &integrator, pass as u64, Mode::Quiet))
+            }
+            Method::Path => {
+                let integrator = PathIntegrator { scene, shadow_rays: settings.shadow_rays };
+                timed(|| camera_pass(scene, settings, &integrator, pass as u64, Mode::Quiet))
+            }
+        };
+        pass_stats.camera_time = camera_time;
+        pass_stats.camera_rays = tally.rays;
+        pass_stats.nonfinite = tally.nonfinite;
+        pass_stats.first_nonfinite = tally.first_nonfinite;
+        pass_stats.edge_pixels = tally.edge_pixels;
+        stats.absorb(pass_stats);
+        for (acc, px) in sum.iter_mut().zip(&film.pixels) {
+            *acc += px.as_dvec3();
+        }
+        pass += 1;
+        last_pass_time = t.elapsed();
+        let average = average_film(w, h, &sum, pass);
+        on_pass(&PassReport {
+            film: &average,
+            passes: pass,
+            elapsed: start.elapsed(),
+            r_caustic: stats.r_caustic,
+            r_global: stats.r_global,
+            k_caustic: stats.k_caustic,
+            k_global: stats.k_global,
+        });
+    }
+    (average_film(w, h, &sum, pass), stats)
+}
+
+fn average_film(w: u32, h: u32, sum: &[DVec3], passes: u32) -> Film {
+    Film { width: w, height: h, pixels: sum.iter().map(|s| (*s / passes.max(1) as f64).as_vec3()).collect() }
 }
 
 /// Camera rays traced per pixel to find the rim of the lights' images.
@@ -175,7 +414,7 @@ const PROBES: u32 = 4;
 /// whose neighbours' probes disagree with theirs (a rim thinner than the probe
 /// spacing). The probes use their own random streams, so choosing the pixels
 /// does not bias the samples that later estimate them.
-fn light_rims(camera: &Camera, integrator: &PhotonIntegrator, seed: u64, tally: &mut Tally) -> Vec<bool> {
+fn light_rims(camera: &Camera, integrator: &impl Integrator, seed: u64, pass: u64, tally: &mut Tally) -> Vec<bool> {
     let (w, h) = (camera.width, camera.height);
     let rows: Vec<(Vec<u8>, Tally)> = (0..h)
         .into_par_iter()
@@ -184,7 +423,7 @@ fn light_rims(camera: &Camera, integrator: &PhotonIntegrator, seed: u64, tally: 
             let counts = (0..w)
                 .map(|col| {
                     let pixel = row as u64 * w as u64 + col as u64;
-                    let mut rng = stream(seed, Domain::EdgeProbes, pixel);
+                    let mut rng = stream(seed, Domain::EdgeProbes, sample_index(pass, pixel));
                     (0..PROBES)
                         .filter(|&s| {
                             let ray = camera.ray(col, row, stratified_2d(s, PROBES, next_2d(&mut rng)));
@@ -220,19 +459,30 @@ fn light_rims(camera: &Camera, integrator: &PhotonIntegrator, seed: u64, tally: 
         .collect()
 }
 
+/// The random-stream index of a pixel in a pass: passes get disjoint streams.
+fn sample_index(pass: u64, pixel: u64) -> u64 {
+    (pass << 40) | pixel
+}
+
 /// Every pixel averages `spp` jittered samples (box filter); pixels on the
 /// rim of a light's image estimate the emitted part with `edge_spp` samples
-/// of their own. Each pixel has its own random stream, so rows can run on any
-/// thread in any order.
-fn camera_pass(scene: &Scene, settings: &Settings, integrator: &PhotonIntegrator, progress: Mode) -> (Film, Tally) {
+/// of their own. Each pixel has its own random stream per pass, so rows can
+/// run on any thread in any order.
+fn camera_pass(
+    scene: &Scene,
+    settings: &Settings,
+    integrator: &impl Integrator,
+    pass: u64,
+    progress: Mode,
+) -> (Film, Tally) {
     let (w, h) = (settings.width, settings.height);
     let camera = scene.camera.with_resolution(w, h);
     let spp = settings.spp.max(1);
     let mut tally = Tally::default();
     let rims = if settings.edge_spp > 0 {
-        light_rims(&camera, integrator, settings.seed, &mut tally)
+        light_rims(&camera, integrator, settings.seed, pass, &mut tally)
     } else {
-        vec![false; (w * h) as usize]
+        vec![false; w as usize * h as usize]
     };
     tally.edge_pixels = rims.iter().filter(|&&r| r).count();
     let phase = Phase::start(progress, "camera pass", h as u64);
@@ -243,7 +493,7 @@ fn camera_pass(scene: &Scene, settings: &Settings, integrator: &PhotonIntegrator
             let pixels = (0..w)
                 .map(|col| {
                     let pixel = row as u64 * w as u64 + col as u64;
-                    let mut rng = stream(settings.seed, Domain::Camera, pixel);
+                    let mut rng = stream(settings.seed, Domain::Camera, sample_index(pass, pixel));
                     let rim = rims[pixel as usize];
                     let mut estimate = |part: Part, n: u32| {
                         let mut sum = DVec3::ZERO;

@@ -103,6 +103,29 @@ fn zero_photons_renders_direct_light_and_warns() {
 }
 
 #[test]
+fn progressive_and_path_tracing_runs_write_their_output() {
+    let dir = scratch_dir("cli-progressive");
+    for (name, extra) in [
+        ("passes.exr", &["--passes", "3", "--photons", "2e3"][..]),
+        ("time.exr", &["--time", "0.5", "--photons", "2e3"][..]),
+        ("path.exr", &["--integrator", "path", "--passes", "2"][..]),
+    ] {
+        let out = dir.join(name);
+        let mut args = vec![out.to_str().unwrap()];
+        args.extend(extra);
+        args.extend(TINY);
+        let o = photonmap(&args);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let film = photonmap::output::read_exr(&out).unwrap();
+        assert!(film.mean() > 0.0 && film.pixels.iter().all(|c| c.is_finite()), "{name}");
+    }
+    let o = photonmap(&["--passes", "2", "--time", "3", dir.join("x.exr").to_str().unwrap()]);
+    assert!(!o.status.success() && stderr(&o).contains("cannot be used with"));
+    let o = photonmap(&["--alpha", "1.5", dir.join("x.exr").to_str().unwrap()]);
+    assert!(!o.status.success() && stderr(&o).contains("between 0 and 1"));
+}
+
+#[test]
 fn help_documents_every_option_with_its_default() {
     let o = photonmap(&["--help"]);
     let help = String::from_utf8_lossy(&o.stdout);

@@ -1,9 +1,40 @@
 //! The same seed gives a bit-identical image whatever the number of threads;
-//! another seed gives another image.
+//! another seed gives another image. One harness, every configuration:
+//! photon mapping, path tracing, and progressive photon mapping.
 
 mod common;
 use common::*;
+use photonmap::film::Film;
+use photonmap::render::{render_progressive, Budget, Method, Settings};
 use photonmap::scene::{Eye, Scene};
+
+fn on_threads(threads: usize, f: impl FnOnce() -> Film + Send) -> Film {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(f)
+}
+
+fn check_thread_independence(render: impl Fn(u64) -> Film + Sync) {
+    let one = on_threads(1, || render(9));
+    assert_eq!(one, on_threads(2, || render(9)));
+    assert_eq!(one, on_threads(3, || render(9)));
+    assert_ne!(one, on_threads(2, || render(10)));
+}
+
+#[test]
+fn path_tracing_is_thread_independent() {
+    let scene = Scene::tncg15(Eye::One);
+    let settings = Settings { method: Method::Path, spp: 2, width: 40, height: 40, ..Settings::default() };
+    check_thread_independence(|seed| render_quiet(&scene, &Settings { seed, ..settings }));
+}
+
+#[test]
+fn progressive_photon_mapping_is_thread_independent() {
+    let scene = Scene::tncg15(Eye::One);
+    let settings =
+        Settings { photons: 10_000, caustic_photons: 10_000, spp: 1, width: 40, height: 40, ..Settings::default() };
+    check_thread_independence(|seed| {
+        render_progressive(&scene, &Settings { seed, ..settings }, Budget::Passes(3), |_| {}).0
+    });
+}
 
 #[test]
 fn same_seed_same_image_on_1_2_and_3_threads() {

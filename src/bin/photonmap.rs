@@ -7,7 +7,7 @@ use photonmap::film::ToneMap;
 use photonmap::metrics::compare;
 use photonmap::output::{check_writable, read_exr, write};
 use photonmap::progress::Mode;
-use photonmap::render::{render, Settings, Stats};
+use photonmap::render::{render, render_progressive, Budget, Method, Settings, Stats};
 use photonmap::scene::{Eye, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -30,7 +30,23 @@ struct Cli {
     /// More output images (repeatable), as for OUT.
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     more_outputs: Vec<PathBuf>,
-    /// Photons emitted for the global map (1e6, 2.5e5 and 1000000 all work).
+    /// Estimator: photon (photon mapping) or path (path tracing with
+    /// next-event estimation, unbiased: the reference).
+    #[arg(long, value_enum, default_value_t = Method::Photon)]
+    integrator: Method,
+    /// Progressive rendering: this many independent passes, averaged; photon
+    /// mapping shrinks its radii from pass to pass so the image converges.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000_000), conflicts_with = "time")]
+    passes: Option<u32>,
+    /// Progressive rendering until this many seconds have passed (no pass
+    /// starts that would end later; at least one runs). The output is
+    /// rewritten every few passes, so stopping early keeps a valid image.
+    #[arg(long, value_parser = parse_seconds)]
+    time: Option<f64>,
+    /// Radius shrinkage of progressive photon mapping (Knaus & Zwicker's alpha).
+    #[arg(long, default_value_t = 2.0 / 3.0, value_parser = parse_alpha)]
+    alpha: f32,
+    /// Photons emitted for the global map, per pass (1e6, 2.5e5 and 1000000 all work).
     #[arg(long, default_value = "1e6", value_parser = parse_count)]
     photons: u64,
     /// Photons emitted towards mirrors and glass for the caustic map
@@ -121,6 +137,20 @@ fn parse_radius(s: &str) -> Result<f32, String> {
     }
 }
 
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v < 1e7 => Ok(v),
+        _ => Err(format!("'{s}' must be a positive number of seconds")),
+    }
+}
+
+fn parse_alpha(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v > 0.0 && v < 1.0 => Ok(v),
+        _ => Err(format!("'{s}' must lie strictly between 0 and 1")),
+    }
+}
+
 fn parse_exposure(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
@@ -156,6 +186,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             .map_err(|e| Error::Invalid(format!("--threads: {e}")))?;
     }
     let settings = Settings {
+        method: cli.integrator,
+        alpha: cli.alpha,
         photons: cli.photons,
         caustic_photons: cli.caustic_photons.unwrap_or(cli.photons),
         spp: cli.spp,
@@ -195,7 +227,38 @@ fn run(cli: Cli) -> Result<(), Error> {
         eprintln!("photonmap: warning: no caustic photons: caustics are missing");
     }
     let start = Instant::now();
-    let (film, stats) = render(&scene, &settings, Mode::detect(cli.quiet));
+    let mode = Mode::detect(cli.quiet);
+    let budget = match (cli.passes, cli.time) {
+        (Some(n), _) => Some(Budget::Passes(n)),
+        (None, Some(s)) => Some(Budget::Seconds(s)),
+        (None, None) => None,
+    };
+    let (film, stats) = match budget {
+        None => render(&scene, &settings, mode),
+        Some(budget) => {
+            let mut last_write = Instant::now();
+            let mut write_error = None;
+            let display = PassDisplay::new(mode, budget);
+            let result = render_progressive(&scene, &settings, budget, |report| {
+                display.update(report);
+                // Rewrite the outputs now and then (atomically), so a user who
+                // stops the run keeps an image of every pass so far.
+                if write_error.is_none() && last_write.elapsed().as_secs_f64() > 10.0 {
+                    for path in &outputs {
+                        if let Err(e) = write(path, report.film, cli.tonemap, cli.exposure) {
+                            write_error = Some(e);
+                        }
+                    }
+                    last_write = Instant::now();
+                }
+            });
+            display.finish();
+            if let Some(e) = write_error {
+                return Err(e);
+            }
+            result
+        }
+    };
     let t = Instant::now();
     for path in &outputs {
         write(path, &film, cli.tonemap, cli.exposure)?;
@@ -244,9 +307,68 @@ fn available_memory() -> Option<u64> {
     Some(kb * 1024)
 }
 
+/// Progress of a progressive render: passes done, radii, time left.
+struct PassDisplay {
+    mode: Mode,
+    budget: Budget,
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl PassDisplay {
+    fn new(mode: Mode, budget: Budget) -> Self {
+        let bar = (mode == Mode::Bar).then(|| {
+            let len = match budget {
+                Budget::Passes(n) => n as u64,
+                Budget::Seconds(s) => s.ceil() as u64,
+            };
+            let bar = indicatif::ProgressBar::new(len);
+            if let Ok(style) = indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}") {
+                bar.set_style(style.progress_chars("=> "));
+            }
+            bar
+        });
+        PassDisplay { mode, budget, bar }
+    }
+
+    fn update(&self, r: &photonmap::render::PassReport) {
+        let elapsed = r.elapsed.as_secs_f64();
+        let left = match self.budget {
+            Budget::Passes(n) => elapsed / r.passes as f64 * (n.saturating_sub(r.passes)) as f64,
+            Budget::Seconds(s) => (s - elapsed).max(0.0),
+        };
+        let msg = format!(
+            "pass {:>5}  k {} / radius cap {:.4} (caustic), k {} / {:.4} (global)  {:>7.1} s elapsed  {:>7.1} s left",
+            r.passes, r.k_caustic, r.r_caustic, r.k_global, r.r_global, elapsed, left
+        );
+        match (&self.bar, self.mode) {
+            (Some(bar), _) => {
+                bar.set_message(msg);
+                bar.set_position(match self.budget {
+                    Budget::Passes(_) => r.passes as u64,
+                    Budget::Seconds(_) => elapsed as u64,
+                });
+            }
+            (None, Mode::Plain) => eprintln!("{msg}"),
+            _ => {}
+        }
+    }
+
+    fn finish(self) {
+        if let Some(bar) = self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}
+
 fn summary(s: &Stats, settings: &Settings, write_time: std::time::Duration, total: std::time::Duration) {
     let mrays = |rays: u64, d: std::time::Duration| rays as f64 / d.as_secs_f64().max(1e-9) / 1e6;
-    eprintln!("photonmap summary ({} threads)", rayon::current_num_threads());
+    eprintln!(
+        "photonmap summary ({} threads, {:?} integrator, {} pass{})",
+        rayon::current_num_threads(),
+        settings.method,
+        s.passes,
+        if s.passes == 1 { "" } else { "es" }
+    );
     eprintln!(
         "  global map:  {:>10} photons emitted, {:>10} stored ({:.1}% first hit mirror/glass)",
         s.global_emitted,

@@ -1,8 +1,63 @@
 //! Integrators: turn a camera ray into radiance.
 //!
-//! * [`photon`]: Jensen's photon-mapping estimator.
+//! * [`photon`]: Jensen's photon-mapping estimator (classic and progressive);
+//! * [`path`]: path tracing with next-event estimation, the unbiased reference.
+//!
+//! Both share the camera pass (`render`), direct lighting and the dielectric.
 
+pub mod path;
 pub mod photon;
+
+use crate::math::{Color, Frame, Ray};
+use crate::optics::{fresnel_dielectric, reflect, refract};
+use crate::photon::map::Scratch;
+use crate::sampling::{next_2d, stratified_2d, Rng};
+use crate::scene::{Hit, Scene};
+use glam::Vec3;
+use std::f32::consts::PI;
+
+/// Which part of the radiance a camera sample estimates. A pixel's value is
+/// the sum of what reaches the eye from a light's own surface (directly or
+/// through mirrors and glass: paths E S* L) and everything else; the two can
+/// be estimated with different numbers of samples, because the first is
+/// cheap and, at the rim of a light's image, has most of the variance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part {
+    All,
+    /// Emitted radiance seen along specular chains only (diffuse hits are dark).
+    Emitted,
+    /// Everything but the emitted part.
+    Reflected,
+}
+
+/// A camera-ray estimator.
+pub trait Integrator: Sync {
+    /// Radiance arriving along a camera ray (towards its origin).
+    fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context) -> Color;
+}
+
+/// Per-thread state: random stream, scratch for lookups, counters.
+pub struct Context<'r> {
+    pub rng: &'r mut Rng,
+    pub scratch: &'r mut Scratch,
+    pub tally: &'r mut Tally,
+    pub pixel: u64,
+}
+
+impl Context<'_> {
+    /// Passes a finite estimate through; counts and drops a non-finite one,
+    /// remembering the first (pixel, estimator). Debug builds stop there.
+    pub fn checked(&mut self, c: Color, estimator: &'static str) -> Color {
+        debug_assert!(c.is_finite(), "{estimator} estimate {c} at pixel {}", self.pixel);
+        if c.is_finite() {
+            c
+        } else {
+            self.tally.nonfinite += 1;
+            self.tally.first_nonfinite.get_or_insert((self.pixel, estimator));
+            Color::ZERO
+        }
+    }
+}
 
 /// What a thread counted while it shaded: rays cast, and samples whose
 /// radiance came out non-finite (a bug at some estimator; never written).
@@ -27,4 +82,58 @@ impl Tally {
         };
         self
     }
+}
+
+/// Light reaching a Lambertian point straight from the lights: `count`
+/// stratified area samples per light, each with a shadow ray,
+/// (rho / pi) * sum L cos_x cos_l / (d^2 pdf_A).
+pub fn direct_light(scene: &Scene, hit: &Hit, n: Vec3, rho: Color, count: u32, ctx: &mut Context) -> Color {
+    let mut sum = Color::ZERO;
+    for light in &scene.lights {
+        let mut light_sum = Color::ZERO;
+        for s in 0..count {
+            let sample = light.sample_point(stratified_2d(s, count, next_2d(ctx.rng)));
+            let to_light = sample.point - hit.point;
+            let dist2 = to_light.length_squared();
+            if !(dist2 > 0.0) {
+                continue;
+            }
+            let w = to_light / dist2.sqrt();
+            let cos_x = n.dot(w);
+            let cos_l = -w.dot(sample.normal);
+            if cos_x <= 0.0 || cos_l <= 0.0 {
+                continue;
+            }
+            let (shadow, dep) = hit.spawn(w);
+            ctx.tally.rays += 1;
+            let t_max = (sample.point - shadow.origin).length();
+            if scene.occluded(&shadow, Some(dep), t_max, Some(light.prim)) {
+                continue;
+            }
+            light_sum += light.radiance * (cos_x * cos_l / (dist2 * sample.pdf_area));
+        }
+        sum += light_sum / count.max(1) as f32;
+    }
+    rho / PI * sum
+}
+
+/// The two directions leaving a smooth dielectric, computed in the local
+/// frame of the surface.
+pub struct GlassBranches {
+    pub fresnel: f32,
+    pub reflected: Vec3,
+    /// Refracted direction and the radiance scale (n_i / n_t)^2 of a camera
+    /// path crossing into the other medium; `None` on total internal reflection.
+    pub refracted: Option<(Vec3, f32)>,
+}
+
+pub fn glass_branches(hit: &Hit, ray: &Ray, ior: f32) -> GlassBranches {
+    let frame = Frame::from_normal(hit.facing_normal(ray.dir));
+    let wi = frame.to_local(-ray.dir);
+    let entering = ray.dir.dot(hit.normal) < 0.0;
+    let (n_i, n_t) = if entering { (1.0, ior) } else { (ior, 1.0) };
+    let fresnel = fresnel_dielectric(wi.z, n_i, n_t);
+    let reflected = frame.to_world(reflect(wi)).normalize();
+    let refracted = refract(wi, n_i / n_t).map(|wt| (frame.to_world(wt).normalize(), (n_i / n_t).powi(2)));
+    GlassBranches { fresnel: if refracted.is_some() { fresnel } else { 1.0 }, reflected, refracted }
 }

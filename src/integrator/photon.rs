@@ -16,12 +16,12 @@
 //! Gather rays that reach a light (directly or through mirrors and glass)
 //! add nothing: those paths belong to the first two rows.
 
-use super::Tally;
+use super::{direct_light, glass_branches, Context, Integrator, Part};
 use crate::material::Material;
 use crate::math::{max_component, Color, Frame, Ray};
-use crate::optics::{fresnel_dielectric, reflect, refract};
-use crate::photon::map::{IrradianceCache, PhotonMap, Scratch};
-use crate::sampling::{cosine_hemisphere, next_2d, stratified_2d, Rng};
+use crate::optics::reflect;
+use crate::photon::map::{IrradianceCache, PhotonMap};
+use crate::sampling::{cosine_hemisphere, next_2d, stratified_2d};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;
 use rand::RngExt;
@@ -54,34 +54,13 @@ pub struct PhotonIntegrator<'a> {
     pub settings: PhotonEstimator,
 }
 
-/// Which part of the radiance a camera sample estimates. A pixel's value is
-/// the sum of what reaches the eye from a light's own surface (directly or
-/// through mirrors and glass) and what diffuse surfaces send; the two can be
-/// estimated with different numbers of samples, because the first is cheap
-/// and, at the rim of a light's image, has most of the variance.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Part {
-    All,
-    /// Emitted radiance seen along specular chains only (diffuse hits are dark).
-    Emitted,
-    /// Radiance from diffuse surfaces only (light surfaces are dark).
-    Reflected,
-}
-
-/// Per-thread state: random stream, scratch for lookups, counters.
-pub struct Context<'r> {
-    pub rng: &'r mut Rng,
-    pub scratch: &'r mut Scratch,
-    pub tally: &'r mut Tally,
-    pub pixel: u64,
+impl Integrator for PhotonIntegrator<'_> {
+    fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context) -> Color {
+        self.trace(ray, None, 0, part, ctx)
+    }
 }
 
 impl PhotonIntegrator<'_> {
-    /// Radiance arriving along a camera ray (towards its origin).
-    pub fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context) -> Color {
-        self.trace(ray, None, 0, part, ctx)
-    }
-
     fn trace(&self, ray: Ray, departure: Option<Departure>, depth: u32, part: Part, ctx: &mut Context) -> Color {
         ctx.tally.rays += 1;
         let Some(hit) = self.scene.intersect(&ray, departure) else {
@@ -95,7 +74,7 @@ impl PhotonIntegrator<'_> {
                     return Color::ZERO;
                 }
                 let n = hit.facing_normal(ray.dir);
-                let direct = self.direct(&hit, n, rho, ctx);
+                let direct = direct_light(self.scene, &hit, n, rho, self.settings.shadow_rays, ctx);
                 let caustic = self.caustic(&hit, n, rho, ctx);
                 let indirect = self.indirect(&hit, n, rho, ctx);
                 self.checked(direct, "direct", ctx)
@@ -139,39 +118,6 @@ impl PhotonIntegrator<'_> {
                 }
             }
         }
-    }
-
-    /// Light → x: area-sampled shadow rays to every light.
-    fn direct(&self, hit: &Hit, n: glam::Vec3, rho: Color, ctx: &mut Context) -> Color {
-        let mut sum = Color::ZERO;
-        let count = self.settings.shadow_rays;
-        for light in &self.scene.lights {
-            let mut light_sum = Color::ZERO;
-            for s in 0..count {
-                let sample = light.sample_point(stratified_2d(s, count, next_2d(ctx.rng)));
-                let to_light = sample.point - hit.point;
-                let dist2 = to_light.length_squared();
-                if !(dist2 > 0.0) {
-                    continue;
-                }
-                let dist = dist2.sqrt();
-                let w = to_light / dist;
-                let cos_x = n.dot(w);
-                let cos_l = -w.dot(sample.normal);
-                if cos_x <= 0.0 || cos_l <= 0.0 {
-                    continue;
-                }
-                let (shadow, dep) = hit.spawn(w);
-                ctx.tally.rays += 1;
-                let t_max = (sample.point - shadow.origin).length();
-                if self.scene.occluded(&shadow, Some(dep), t_max, Some(light.prim)) {
-                    continue;
-                }
-                light_sum += light.radiance * (cos_x * cos_l / (dist2 * sample.pdf_area));
-            }
-            sum += light_sum / count.max(1) as f32;
-        }
-        rho / PI * sum
     }
 
     /// Light → specular+ → x: the caustic map.
@@ -231,34 +177,6 @@ impl PhotonIntegrator<'_> {
     }
 
     fn checked(&self, c: Color, estimator: &'static str, ctx: &mut Context) -> Color {
-        debug_assert!(c.is_finite(), "{estimator} estimate {c} at pixel {}", ctx.pixel);
-        if c.is_finite() {
-            c
-        } else {
-            ctx.tally.nonfinite += 1;
-            ctx.tally.first_nonfinite.get_or_insert((ctx.pixel, estimator));
-            Color::ZERO
-        }
+        ctx.checked(c, estimator)
     }
-}
-
-/// The two directions leaving a smooth dielectric, computed in the local
-/// frame of the surface.
-pub struct GlassBranches {
-    pub fresnel: f32,
-    pub reflected: glam::Vec3,
-    /// Refracted direction and the radiance scale (n_i / n_t)^2 of a camera
-    /// path crossing into the other medium; `None` on total internal reflection.
-    pub refracted: Option<(glam::Vec3, f32)>,
-}
-
-pub fn glass_branches(hit: &Hit, ray: &Ray, ior: f32) -> GlassBranches {
-    let frame = Frame::from_normal(hit.facing_normal(ray.dir));
-    let wi = frame.to_local(-ray.dir);
-    let entering = ray.dir.dot(hit.normal) < 0.0;
-    let (n_i, n_t) = if entering { (1.0, ior) } else { (ior, 1.0) };
-    let fresnel = fresnel_dielectric(wi.z, n_i, n_t);
-    let reflected = frame.to_world(reflect(wi)).normalize();
-    let refracted = refract(wi, n_i / n_t).map(|wt| (frame.to_world(wt).normalize(), (n_i / n_t).powi(2)));
-    GlassBranches { fresnel: if refracted.is_some() { fresnel } else { 1.0 }, reflected, refracted }
 }
