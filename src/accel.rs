@@ -4,7 +4,7 @@
 //! pruning the far one. Every ray of the renderer goes through here.
 
 use crate::math::Ray;
-use crate::shape::{Departure, Shape, ShapeHit};
+use crate::shape::{Departure, RayShear, Shape, ShapeHit};
 use glam::Vec3;
 
 const BINS: usize = 16;
@@ -76,9 +76,10 @@ impl Accel {
     /// Nearest hit in (0, t_max) and the index of the primitive hit.
     pub fn closest_hit(&self, ray: &Ray, departure: Option<Departure>, t_max: f32) -> Option<(u32, ShapeHit)> {
         let mut best: Option<(&Shape, u32, f32, [f32; 2])> = None;
+        let rs = RayShear::new(ray);
         self.traverse(ray, t_max, |shape, index, t_limit| {
             let departed = departure.filter(|d| d.prim == index).map(|d| d.outward);
-            if let Some((t, uv)) = shape.distance(ray, *t_limit, departed) {
+            if let Some((t, uv)) = shape.distance(ray, &rs, *t_limit, departed) {
                 *t_limit = t;
                 best = Some((shape, index, t, uv));
             }
@@ -91,12 +92,13 @@ impl Accel {
     /// Whether anything other than primitive `ignore` lies in (0, t_max).
     pub fn occluded(&self, ray: &Ray, departure: Option<Departure>, t_max: f32, ignore: Option<u32>) -> bool {
         let mut blocked = false;
+        let rs = RayShear::new(ray);
         self.traverse(ray, t_max, |shape, index, t_limit| {
             if ignore == Some(index) {
                 return false;
             }
             let departed = departure.filter(|d| d.prim == index).map(|d| d.outward);
-            blocked = shape.distance(ray, *t_limit, departed).is_some();
+            blocked = shape.distance(ray, &rs, *t_limit, departed).is_some();
             blocked
         });
         blocked

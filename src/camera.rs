@@ -35,6 +35,15 @@ impl Camera {
         self
     }
 
+    /// The same camera in a scene whose lengths are all multiplied by `s`.
+    pub fn scaled(mut self, s: f32) -> Self {
+        self.eye *= s;
+        self.upper_left *= s;
+        self.across *= s;
+        self.down *= s;
+        self
+    }
+
     /// The ray through image position (`col` + u.x, `row` + u.y), row 0 at the top.
     pub fn ray(&self, col: u32, row: u32, u: Vec2) -> Ray {
         let fx = (col as f32 + u.x) / self.width as f32;

@@ -65,6 +65,36 @@ pub struct Scene {
     targets: Vec<Target>,
 }
 
+/// A scene's ingredients, before [`Scene::from_parts`] derives what the
+/// renderer needs from them.
+#[derive(Clone, Debug)]
+pub struct SceneParts {
+    pub prims: Vec<Prim>,
+    pub materials: Vec<Material>,
+    /// Disk lights and their radiance.
+    pub lights: Vec<(Disk, Color)>,
+    pub camera: Camera,
+}
+
+impl SceneParts {
+    /// The same scene with every length multiplied by `s` (> 0). Radiance is
+    /// per unit area and solid angle, so the image is unchanged.
+    pub fn scaled(mut self, s: f32) -> Self {
+        for p in &mut self.prims {
+            p.shape = match p.shape {
+                Shape::Triangle(t) => Shape::Triangle(Triangle::new(t.v0 * s, t.v1 * s, t.v2 * s)),
+                Shape::Sphere(sp) => Shape::Sphere(Sphere { center: sp.center * s, radius: sp.radius * s }),
+                Shape::Disk(d) => Shape::Disk(Disk { center: d.center * s, radius: d.radius * s, ..d }),
+            };
+        }
+        for (d, _) in &mut self.lights {
+            *d = Disk { center: d.center * s, radius: d.radius * s, ..*d };
+        }
+        self.camera = self.camera.scaled(s);
+        self
+    }
+}
+
 /// The eye positions of the course's camera.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Eye {
@@ -111,6 +141,16 @@ impl Scene {
 
     /// The built-in TNCG15 room (see notes/default-scene.md), 800 x 800.
     pub fn tncg15(eye: Eye) -> Self {
+        Scene::from_parts(Scene::tncg15_parts(eye))
+    }
+
+    pub fn from_parts(p: SceneParts) -> Self {
+        Scene::new(p.prims, p.materials, p.lights, p.camera)
+    }
+
+    /// The built-in room's primitives, materials, light and camera, before
+    /// assembly: tests vary them (scale the scene, change a material).
+    pub fn tncg15_parts(eye: Eye) -> SceneParts {
         let hexagon = [
             Vec2::new(-3.0, 0.0),
             Vec2::new(0.0, 6.0),
@@ -192,7 +232,7 @@ impl Scene {
             800,
             800,
         );
-        Scene::new(prims, materials, vec![(light, Color::splat(10.0))], camera)
+        SceneParts { prims, materials, lights: vec![(light, Color::splat(10.0))], camera }
     }
 
     pub fn intersect(&self, ray: &Ray, departure: Option<Departure>) -> Option<Hit> {

@@ -47,8 +47,11 @@ pub struct PassOutput {
 /// Traces `n` photons of `pass`; `on_block` is told the number of photons
 /// done after each block (for progress bars).
 pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn Fn(u64) + Sync)) -> PassOutput {
-    if n == 0 || scene.lights.is_empty() || (pass == Pass::Caustic && scene.specular_targets().is_empty()) {
-        return PassOutput::default();
+    // Lights that emit nothing emit no photons (choosing among them by power
+    // would divide zero by zero).
+    let emits = max_component(scene.emitted_power()) > 0.0;
+    if n == 0 || !emits || (pass == Pass::Caustic && scene.specular_targets().is_empty()) {
+        return PassOutput { emitted: n, ..PassOutput::default() };
     }
     let rays = AtomicU64::new(0);
     let first_specular = AtomicU64::new(0);
@@ -100,6 +103,9 @@ fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> Option<(Ray, Depart
         }
     }
     let p_light = max_component(light.power()) / total;
+    if !(p_light > 0.0) {
+        return None;
+    }
     let departure = Departure { prim: light.prim, outward: true };
     match pass {
         Pass::Global => {
@@ -268,6 +274,20 @@ mod tests {
         let out = trace_pass(&scene, Pass::Caustic, 200_000, 5, &|_| {});
         assert!(out.photons.len() > 150_000);
         assert!(out.photons.iter().all(|p| p.flux().is_finite() && p.flux().max_element() > 0.0));
+    }
+
+    /// Regression: with every light at radiance 0 the light was chosen with
+    /// probability 0 / 0 and every photon carried NaN power.
+    #[test]
+    fn a_light_of_radiance_zero_emits_no_photons() {
+        let mut parts = Scene::tncg15_parts(Eye::One);
+        parts.lights[0].1 = crate::math::Color::ZERO;
+        let scene = Scene::from_parts(parts);
+        for pass in [Pass::Global, Pass::Caustic] {
+            let out = trace_pass(&scene, pass, 1000, 1, &|_| {});
+            assert!(out.photons.is_empty());
+            assert_eq!(out.emitted, 1000);
+        }
     }
 
     #[test]
