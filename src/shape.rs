@@ -104,11 +104,26 @@ impl Triangle {
         if self.normal == Vec3::ZERO {
             return None;
         }
-        let [kx, ky, kz] = rs.k;
+        // One specialisation per dominant axis: the permutation is then a
+        // compile-time shuffle, not three indexed loads.
+        match rs.k[2] {
+            0 => self.distance_in::<1, 2, 0>(ray, rs, t_max),
+            1 => self.distance_in::<2, 0, 1>(ray, rs, t_max),
+            _ => self.distance_in::<0, 1, 2>(ray, rs, t_max),
+        }
+    }
+
+    #[inline(always)]
+    fn distance_in<const KX: usize, const KY: usize, const KZ: usize>(
+        &self,
+        ray: &Ray,
+        rs: &RayShear,
+        t_max: f32,
+    ) -> Option<(f32, f32, f32)> {
         let shear = |p: Vertex| {
-            let q = p - ray.origin;
-            let z = q[kz];
-            Vec3::new(q[kx] + rs.shear.x * z, q[ky] + rs.shear.y * z, z)
+            let q = (p - ray.origin).to_array();
+            let z = q[KZ];
+            Vec3::new(q[KX] + rs.shear.x * z, q[KY] + rs.shear.y * z, z)
         };
         let (p0, p1, p2) = (shear(self.v0), shear(self.v1), shear(self.v2));
         let mut e0 = p1.x * p2.y - p1.y * p2.x;
