@@ -104,6 +104,18 @@ impl Triangle {
         if self.normal == Vec3::ZERO {
             return None;
         }
+        // Early out: a plane behind the origin or beyond t_max cannot hold
+        // the hit. The test is conservative by the rounding bound of its two
+        // dot products, so it never rejects what the exact test would accept
+        // and the watertight decision below stays the only one near edges.
+        let to_plane = (self.v0 - ray.origin).dot(self.normal);
+        let along = ray.dir.dot(self.normal);
+        let slack = gamma(6) * (self.v0.abs() + ray.origin.abs()).dot(self.normal.abs());
+        // Signed so that a plane ahead of the origin is positive.
+        let (ahead, speed) = if along >= 0.0 { (to_plane, along) } else { (-to_plane, -along) };
+        if ahead < -slack || ahead > speed * t_max * (1.0 + gamma(4)) + slack {
+            return None;
+        }
         // One specialisation per dominant axis: the permutation is then a
         // compile-time shuffle, not three indexed loads.
         match rs.k[2] {
