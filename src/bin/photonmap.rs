@@ -35,7 +35,8 @@ struct Cli {
     #[arg(long, value_enum, default_value_t = Method::Photon)]
     integrator: Method,
     /// Progressive rendering: this many independent passes, averaged; photon
-    /// mapping shrinks its radii from pass to pass so the image converges.
+    /// mapping narrows its estimates (fewer photons each, smaller radius
+    /// caps) from pass to pass so the image converges to the true one.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000_000), conflicts_with = "time")]
     passes: Option<u32>,
     /// Progressive rendering until this many seconds have passed (no pass
@@ -43,7 +44,9 @@ struct Cli {
     /// rewritten every few passes, so stopping early keeps a valid image.
     #[arg(long, value_parser = parse_seconds)]
     time: Option<f64>,
-    /// Radius shrinkage of progressive photon mapping (Knaus & Zwicker's alpha).
+    /// How fast progressive photon mapping narrows its estimates (Knaus &
+    /// Zwicker's alpha): pass i uses k and squared radius caps times
+    /// prod_{j<i} (j + alpha - 1) / j.
     #[arg(long, default_value_t = 2.0 / 3.0, value_parser = parse_alpha)]
     alpha: f32,
     /// Photons emitted for the global map, per pass (1e6, 2.5e5 and 1000000 all work).
@@ -369,14 +372,15 @@ fn summary(s: &Stats, settings: &Settings, write_time: std::time::Duration, tota
         s.passes,
         if s.passes == 1 { "" } else { "es" }
     );
+    let last = if s.passes > 1 { " in the last pass" } else { "" };
     eprintln!(
-        "  global map:  {:>10} photons emitted, {:>10} stored ({:.1}% first hit mirror/glass)",
+        "  global map:  {:>10} photons emitted, {:>10} stored{last} ({:.1}% first hit mirror/glass)",
         s.global_emitted,
         s.global_stored,
         100.0 * s.global_specular_hits as f64 / s.global_emitted.max(1) as f64
     );
     eprintln!(
-        "  caustic map: {:>10} photons emitted, {:>10} stored ({:.1}% first hit mirror/glass: aimed)",
+        "  caustic map: {:>10} photons emitted, {:>10} stored{last} ({:.1}% first hit mirror/glass: aimed)",
         s.caustic_emitted,
         s.caustic_stored,
         100.0 * s.caustic_aimed_hits as f64 / s.caustic_emitted.max(1) as f64
