@@ -10,6 +10,10 @@
 //! * `Scene`: [`scene::Scene`] (the room: [`scene::Scene::tncg15`]);
 //! * `Camera`, `Pixel`: [`camera::Camera`], [`film::Film`], [`render`].
 
+// `!(x > 0.0)` is written on purpose throughout: unlike `x <= 0.0` it also
+// rejects NaN, which is how the numerics stop a bad value at its source.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod accel;
 pub mod camera;
 pub mod error;

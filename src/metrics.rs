@@ -43,7 +43,10 @@ pub fn box_down(film: &Film, f: u32) -> Film {
 /// Compares `test` (any multiple of the reference's size) with `reference`.
 /// Non-finite test values are counted and treated as 0, as metrics.py does.
 pub fn compare(test: &Film, reference: &Film) -> Option<Metrics> {
-    if reference.width == 0 || test.width % reference.width != 0 || test.height % reference.height != 0 {
+    if reference.width == 0
+        || !test.width.is_multiple_of(reference.width)
+        || !test.height.is_multiple_of(reference.height)
+    {
         return None;
     }
     let f = test.width / reference.width;

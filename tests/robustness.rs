@@ -39,8 +39,9 @@ fn leaks(n: usize, seed: u64, intersect: impl Fn(&Scene, &Ray) -> Option<(u32, f
         Shape::Triangle(t) => t,
         _ => unreachable!("the first 24 primitives and 26..30 are triangles"),
     };
-    // (a, b, the normals and a vertex of the faces that share the edge)
-    let mut edges: Vec<(Vec3, Vec3, Vec<(Vec3, Vec3)>)> = Vec::new();
+    // (a, b, the normal and a vertex of each tetrahedron face sharing the edge)
+    type Edge = (Vec3, Vec3, Vec<(Vec3, Vec3)>);
+    let mut edges: Vec<Edge> = Vec::new();
     for i in (0..24).chain(26..30) {
         let t = triangle(i);
         for (a, b) in [(t.v0, t.v1), (t.v1, t.v2), (t.v2, t.v0)] {
