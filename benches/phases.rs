@@ -66,5 +66,34 @@ fn full_render(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, photon_pass, kd_tree_build, radiance_queries, full_render);
+/// What skipping saves: a black room (no photon maps needed) and the
+/// default room, each rendered with the skips on and forced off.
+fn skips(c: &mut Criterion) {
+    let mut black = Scene::tncg15_parts(Eye::One);
+    for m in &mut black.materials {
+        if let photonmap::material::Material::Lambertian { rho } = m {
+            *rho = glam::Vec3::ZERO;
+        }
+    }
+    let scenes = [("black_room", Scene::from_parts(black)), ("default_room", Scene::tncg15(Eye::One))];
+    let mut g = c.benchmark_group("skips");
+    g.sample_size(10);
+    for (name, scene) in &scenes {
+        for skip in [true, false] {
+            let settings = Settings {
+                photons: 200_000,
+                caustic_photons: 200_000,
+                width: 64,
+                height: 64,
+                skip,
+                ..Settings::default()
+            };
+            let label = format!("{name}/{}", if skip { "skip" } else { "no_skip" });
+            g.bench_function(label, |b| b.iter(|| black_box(render(scene, &settings, Mode::Quiet).0.mean())));
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, photon_pass, kd_tree_build, radiance_queries, full_render, skips);
 criterion_main!(benches);

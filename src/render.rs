@@ -52,6 +52,9 @@ pub struct Settings {
     pub cache_stride: usize,
     /// Samples of the emitted part in pixels on the rim of a light's image.
     pub edge_spp: u32,
+    /// Skip what the scene does not need (photon maps it cannot use, shadow
+    /// rays towards lights facing away); off only to check the skips.
+    pub skip: bool,
     /// Progressive photon mapping's radius shrinkage (Knaus & Zwicker 2011):
     /// pass i uses r_i^2 = r_1^2 * prod_{k<i} (k + alpha - 1) / k.
     pub alpha: f32,
@@ -75,6 +78,7 @@ impl Default for Settings {
             shadow_rays: 2,
             cache_stride: 4,
             edge_spp: 256,
+            skip: true,
             alpha: 2.0 / 3.0,
         }
     }
@@ -139,6 +143,11 @@ pub struct Stats {
     pub k_caustic: usize,
     /// Passes rendered (1 for a classic render).
     pub passes: u32,
+    /// Photon maps the scene cannot use, not built.
+    pub skipped_global: bool,
+    pub skipped_caustic: bool,
+    /// Shadow rays not cast towards lights facing away.
+    pub shadow_rays_skipped: u64,
 }
 
 impl Stats {
@@ -165,6 +174,9 @@ impl Stats {
         self.k_global = o.k_global;
         self.k_caustic = o.k_caustic;
         self.passes += o.passes;
+        self.skipped_global = o.skipped_global;
+        self.skipped_caustic = o.skipped_caustic;
+        self.shadow_rays_skipped += o.shadow_rays_skipped;
     }
 }
 
@@ -224,6 +236,14 @@ fn photon_pass(
     stats: &mut Stats,
 ) -> Maps {
     let seed = pass_seed(settings.seed, pass);
+    let needs = scene.needs();
+    stats.skipped_global = settings.skip && !needs.global;
+    stats.skipped_caustic = settings.skip && !needs.caustics;
+    let settings = &Settings {
+        photons: if stats.skipped_global { 0 } else { settings.photons },
+        caustic_photons: if stats.skipped_caustic { 0 } else { settings.caustic_photons },
+        ..*settings
+    };
     let t = Instant::now();
     let phase = Phase::start(progress, "photon pass", settings.photons + settings.caustic_photons);
     let global = trace_pass(scene, Pass::Global, settings.photons, seed, &|n| phase.advance(n));
@@ -273,6 +293,7 @@ fn photon_integrator<'a>(
             r_caustic: est.r_caustic,
             gather_rays: settings.gather_rays,
             shadow_rays: settings.shadow_rays,
+            skip: settings.skip,
         },
     }
 }
@@ -295,7 +316,7 @@ pub fn render(scene: &Scene, settings: &Settings, progress: Mode) -> (Film, Stat
             timed(|| camera_pass(scene, settings, &integrator, 0, progress))
         }
         Method::Path => {
-            let integrator = PathIntegrator { scene, shadow_rays: settings.shadow_rays };
+            let integrator = PathIntegrator { scene, shadow_rays: settings.shadow_rays, skip: settings.skip };
             timed(|| camera_pass(scene, settings, &integrator, 0, progress))
         }
     };
@@ -304,6 +325,7 @@ pub fn render(scene: &Scene, settings: &Settings, progress: Mode) -> (Film, Stat
     stats.nonfinite = tally.nonfinite;
     stats.first_nonfinite = tally.first_nonfinite;
     stats.edge_pixels = tally.edge_pixels;
+    stats.shadow_rays_skipped = tally.shadow_rays_skipped;
     (film, stats)
 }
 
@@ -373,7 +395,7 @@ pub fn render_progressive(
                 timed(|| camera_pass(scene, settings, &integrator, pass as u64, Mode::Quiet))
             }
             Method::Path => {
-                let integrator = PathIntegrator { scene, shadow_rays: settings.shadow_rays };
+                let integrator = PathIntegrator { scene, shadow_rays: settings.shadow_rays, skip: settings.skip };
                 timed(|| camera_pass(scene, settings, &integrator, pass as u64, Mode::Quiet))
             }
         };
@@ -382,6 +404,7 @@ pub fn render_progressive(
         pass_stats.nonfinite = tally.nonfinite;
         pass_stats.first_nonfinite = tally.first_nonfinite;
         pass_stats.edge_pixels = tally.edge_pixels;
+        pass_stats.shadow_rays_skipped = tally.shadow_rays_skipped;
         stats.absorb(pass_stats);
         for (acc, px) in sum.iter_mut().zip(&film.pixels) {
             *acc += px.as_dvec3();

@@ -46,6 +46,15 @@ impl Hit {
     }
 }
 
+/// The parts of light transport a scene can have (see [`Scene::needs`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Needs {
+    /// Light reaching diffuse surfaces through mirrors or glass.
+    pub caustics: bool,
+    /// Light reflected between diffuse surfaces.
+    pub global: bool,
+}
+
 /// A bounding sphere of a specular object, for aiming caustic photons.
 #[derive(Clone, Copy, Debug)]
 pub struct Target {
@@ -277,6 +286,21 @@ impl Scene {
     /// Total emitted power per channel.
     pub fn emitted_power(&self) -> Color {
         self.lights.iter().map(|l| l.power()).sum()
+    }
+
+    /// What this scene's light transport can need, so that a render skips
+    /// the rest.
+    pub fn needs(&self) -> Needs {
+        let lit = crate::math::max_component(self.emitted_power()) > 0.0;
+        let diffuse = (0..self.prims.len() as u32).any(|i| self.material(i).diffuse_rho().is_some());
+        Needs {
+            // Caustic paths need a mirror or glass object and a diffuse
+            // surface to land on.
+            caustics: lit && diffuse && !self.targets.is_empty(),
+            // Indirect diffuse light needs light reflected by a diffuse
+            // surface (a black room has none).
+            global: lit && diffuse,
+        }
     }
 }
 

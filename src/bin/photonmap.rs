@@ -98,6 +98,11 @@ struct Cli {
     /// (directly or in mirrors and glass; 0: no extra samples).
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(0..=1_000_000))]
     edge_spp: u32,
+    /// Do everything even where the scene cannot use it (photon maps, shadow
+    /// rays towards lights facing away): for checking that the skips change
+    /// nothing.
+    #[arg(long)]
+    no_skip: bool,
     /// Tone mapping of 8-bit outputs: linear (255.99 / i_max) or sqrt.
     #[arg(long, value_enum, default_value_t = ToneMap::Linear)]
     tonemap: ToneMap,
@@ -204,6 +209,7 @@ fn run(cli: Cli) -> Result<(), Error> {
         gather_rays: cli.gather_rays,
         shadow_rays: cli.shadow_rays,
         edge_spp: cli.edge_spp,
+        skip: !cli.no_skip,
         ..Settings::default()
     };
     // Refuse before allocating: a map that cannot fit would abort the
@@ -415,6 +421,19 @@ fn summary(s: &Stats, settings: &Settings, write_time: std::time::Duration, tota
         "               {} pixels on the rim of a light's image took {} extra samples",
         s.edge_pixels, settings.edge_spp
     );
+    let mut skipped = Vec::new();
+    if s.skipped_global {
+        skipped.push("the global map and its photons (no diffuse surface reflects light)".to_string());
+    }
+    if s.skipped_caustic {
+        skipped.push("the caustic map and its photons (no mirror or glass, or nothing diffuse to land on)".to_string());
+    }
+    if s.shadow_rays_skipped > 0 {
+        skipped.push(format!("{} shadow rays towards lights facing away", s.shadow_rays_skipped));
+    }
+    if !skipped.is_empty() {
+        eprintln!("  skipped:     {}", skipped.join("; "));
+    }
     eprintln!("  write        {:>8.3} s", write_time.as_secs_f64());
     eprintln!("  total        {:>8.3} s", total.as_secs_f64());
 }

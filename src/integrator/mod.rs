@@ -67,6 +67,8 @@ pub struct Tally {
     pub nonfinite: u64,
     /// Pixels given extra samples on the rim of a light's image.
     pub edge_pixels: usize,
+    /// Shadow rays not cast: the light's back faced the point.
+    pub shadow_rays_skipped: u64,
     /// First non-finite sample seen: (pixel index, estimator name).
     pub first_nonfinite: Option<(u64, &'static str)>,
 }
@@ -76,6 +78,7 @@ impl Tally {
         self.rays += other.rays;
         self.nonfinite += other.nonfinite;
         self.edge_pixels += other.edge_pixels;
+        self.shadow_rays_skipped += other.shadow_rays_skipped;
         self.first_nonfinite = match (self.first_nonfinite, other.first_nonfinite) {
             (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
             (a, b) => a.or(b),
@@ -86,10 +89,16 @@ impl Tally {
 
 /// Light reaching a Lambertian point straight from the lights: `count`
 /// stratified area samples per light, each with a shadow ray,
-/// (rho / pi) * sum L cos_x cos_l / (d^2 pdf_A).
-pub fn direct_light(scene: &Scene, hit: &Hit, n: Vec3, rho: Color, count: u32, ctx: &mut Context) -> Color {
+/// (rho / pi) * sum L cos_x cos_l / (d^2 pdf_A). With `skip`, a light whose
+/// emitting side faces away from the point (a one-sided disk seen from
+/// behind or edge-on, where every sample has cos_l <= 0) is not sampled.
+pub fn direct_light(scene: &Scene, hit: &Hit, n: Vec3, rho: Color, count: u32, skip: bool, ctx: &mut Context) -> Color {
     let mut sum = Color::ZERO;
     for light in &scene.lights {
+        if skip && (hit.point - light.disk.center).dot(light.disk.normal) <= 0.0 {
+            ctx.tally.shadow_rays_skipped += count as u64;
+            continue;
+        }
         let mut light_sum = Color::ZERO;
         for s in 0..count {
             let sample = light.sample_point(stratified_2d(s, count, next_2d(ctx.rng)));

@@ -25,6 +25,8 @@ pub struct PathIntegrator<'a> {
     pub scene: &'a Scene,
     /// Shadow rays per light at each diffuse vertex.
     pub shadow_rays: u32,
+    /// Skip lights that face away from the shaded point.
+    pub skip: bool,
 }
 
 impl Integrator for PathIntegrator<'_> {
@@ -58,7 +60,7 @@ impl Integrator for PathIntegrator<'_> {
                         break;
                     }
                     let n = hit.facing_normal(ray.dir);
-                    let direct = direct_light(self.scene, &hit, n, rho, self.shadow_rays, ctx);
+                    let direct = direct_light(self.scene, &hit, n, rho, self.shadow_rays, self.skip, ctx);
                     radiance += throughput * ctx.checked(direct, "path direct");
                     count_emission = false;
                     specular_chain = false;

@@ -45,6 +45,8 @@ pub struct PhotonEstimator {
     pub gather_rays: u32,
     /// Shadow rays per light per diffuse camera hit.
     pub shadow_rays: u32,
+    /// Skip lights that face away from the shaded point.
+    pub skip: bool,
 }
 
 pub struct PhotonIntegrator<'a> {
@@ -74,7 +76,7 @@ impl PhotonIntegrator<'_> {
                     return Color::ZERO;
                 }
                 let n = hit.facing_normal(ray.dir);
-                let direct = direct_light(self.scene, &hit, n, rho, self.settings.shadow_rays, ctx);
+                let direct = direct_light(self.scene, &hit, n, rho, self.settings.shadow_rays, self.settings.skip, ctx);
                 let caustic = self.caustic(&hit, n, rho, ctx);
                 let indirect = self.indirect(&hit, n, rho, ctx);
                 self.checked(direct, "direct", ctx)

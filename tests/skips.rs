@@ -1,0 +1,96 @@
+//! Skipping what a scene does not need changes nothing but the time: each
+//! skip renders the same image with the skip forced off.
+
+use photonmap::film::Film;
+use photonmap::material::Material;
+use photonmap::metrics::compare;
+use photonmap::progress::Mode;
+use photonmap::render::{render, Settings, Stats};
+use photonmap::scene::{Eye, Scene, SceneParts};
+
+fn settings(skip: bool) -> Settings {
+    Settings { photons: 50_000, caustic_photons: 50_000, width: 64, height: 64, skip, ..Settings::default() }
+}
+
+fn both_ways(parts: SceneParts) -> ((Film, Stats), (Film, Stats)) {
+    let scene = Scene::from_parts(parts);
+    (render(&scene, &settings(true), Mode::Quiet), render(&scene, &settings(false), Mode::Quiet))
+}
+
+/// Asserts that `a` and `b` differ by no more than two renders of the same
+/// scene with different seeds do (RMSE within 1.2x, means within 3x the
+/// seed-to-seed difference or 1%).
+fn same_within_noise(scene: &Scene, a: &Film, b: &Film, label: &str) {
+    let (other, _) = render(scene, &Settings { seed: 2, ..settings(false) }, Mode::Quiet);
+    let diff = compare(a, b).unwrap();
+    let noise = compare(&other, b).unwrap();
+    let rel = |x: f64, y: f64| (x / y - 1.0).abs();
+    eprintln!(
+        "{label}: rmse {:.5} vs seed noise {:.5}; means {:.5} {:.5} {:.5}",
+        diff.rmse,
+        noise.rmse,
+        a.mean(),
+        b.mean(),
+        other.mean()
+    );
+    assert!(diff.rmse <= 1.2 * noise.rmse, "{label}: rmse {} vs noise {}", diff.rmse, noise.rmse);
+    assert!(rel(a.mean(), b.mean()) <= (3.0 * rel(other.mean(), b.mean())).max(0.01), "{label}: means");
+}
+
+#[test]
+fn a_black_room_needs_no_photon_maps() {
+    let mut parts = Scene::tncg15_parts(Eye::One);
+    for m in &mut parts.materials {
+        if let Material::Lambertian { rho } = m {
+            *rho = photonmap::math::Color::ZERO;
+        }
+    }
+    let ((on, s_on), (off, s_off)) = both_ways(parts);
+    assert!(s_on.skipped_global && s_on.skipped_caustic);
+    assert!(!s_off.skipped_global && !s_off.skipped_caustic && s_off.photon_rays > 0);
+    assert_eq!(s_on.photon_rays, 0);
+    // Nothing diffuse reflects, so both ways give the very same image: the
+    // light, seen directly and in the mirror and the glass.
+    assert!(on == off, "images differ");
+    assert!(on.mean() > 0.0);
+}
+
+#[test]
+fn a_room_without_mirror_or_glass_needs_no_caustic_map() {
+    let mut parts = Scene::tncg15_parts(Eye::One);
+    let specular: Vec<usize> = parts
+        .prims
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| parts.materials[p.material as usize].is_specular())
+        .map(|(i, _)| i)
+        .collect();
+    for i in specular.into_iter().rev() {
+        parts.prims.remove(i);
+    }
+    let scene = Scene::from_parts(parts.clone());
+    let ((on, s_on), (off, s_off)) = both_ways(parts);
+    assert!(s_on.skipped_caustic && !s_on.skipped_global && !s_off.skipped_caustic);
+    same_within_noise(&scene, &on, &off, "no mirror or glass");
+}
+
+/// The default light is a one-sided disk 0.001 below the ceiling: ceiling
+/// points see only its back. Flipped to face up, it lights only the ceiling.
+#[test]
+fn lights_facing_away_get_no_shadow_rays() {
+    for flip in [false, true] {
+        let mut parts = Scene::tncg15_parts(Eye::One);
+        if flip {
+            parts.lights[0].0.normal = -parts.lights[0].0.normal;
+        }
+        let scene = Scene::from_parts(parts);
+        let (on, s_on) = render(&scene, &settings(true), Mode::Quiet);
+        let (off, s_off) = render(&scene, &settings(false), Mode::Quiet);
+        assert!(s_on.shadow_rays_skipped > 0 && s_off.shadow_rays_skipped == 0);
+        // No ray was ever cast for a sample with cos_l <= 0; the skip saves
+        // choosing the samples, and the rays cast stay the same in count.
+        assert!(s_on.camera_rays.abs_diff(s_off.camera_rays) < s_off.camera_rays / 50);
+        // Skipped samples draw no random numbers, so the images differ by noise only.
+        same_within_noise(&scene, &on, &off, if flip { "light facing up" } else { "ceiling behind the light" });
+    }
+}
