@@ -191,30 +191,20 @@ struct Estimates {
 }
 
 impl Estimates {
-    fn classic(scene: &Scene, settings: &Settings) -> Self {
-        Estimates {
-            k_global: settings.k_global,
-            k_caustic: settings.k_caustic,
-            r_global: settings.r_global(scene),
-            r_caustic: settings.r_caustic(scene),
-        }
-    }
-
-    /// Pass `i` (0-based) of a progressive render: k and the squared radius
-    /// cap scaled by s_i = prod_{k=1}^{i} (k + alpha - 1) / k. Per pass the
+    /// Pass `i` (0-based; pass 0 is the classic render's settings): k and the
+    /// squared radius cap scaled by s_i = prod_{k=1}^{i} (k + alpha - 1) / k. Per pass the
     /// variance grows as 1 / s_i and the bias shrinks as s_i, so the average
     /// of n passes has variance ~ n^-alpha and bias ~ n^(alpha-1) (Knaus &
     /// Zwicker 2011), while each estimate keeps adapting to the local density.
     /// k stays at least 2 (the estimators use the k-1 photons inside the rim).
     fn progressive(scene: &Scene, settings: &Settings, pass: u32) -> Self {
         let s: f64 = (1..=pass).map(|k| (k as f64 + settings.alpha as f64 - 1.0) / k as f64).product();
-        let base = Estimates::classic(scene, settings);
         let k = |k: usize| ((k as f64 * s).round() as usize).max(2);
         Estimates {
-            k_global: k(base.k_global),
-            k_caustic: k(base.k_caustic),
-            r_global: base.r_global * s.sqrt() as f32,
-            r_caustic: base.r_caustic * s.sqrt() as f32,
+            k_global: k(settings.k_global),
+            k_caustic: k(settings.k_caustic),
+            r_global: settings.r_global(scene) * s.sqrt() as f32,
+            r_caustic: settings.r_caustic(scene) * s.sqrt() as f32,
         }
     }
 }
@@ -300,24 +290,26 @@ fn photon_integrator<'a>(
 
 /// Renders `scene` (its camera at `settings`' resolution) in one pass.
 pub fn render(scene: &Scene, settings: &Settings, progress: Mode) -> (Film, Stats) {
-    let mut stats = Stats {
-        r_global: settings.r_global(scene),
-        r_caustic: settings.r_caustic(scene),
-        k_global: settings.k_global,
-        k_caustic: settings.k_caustic,
-        passes: 1,
-        ..Stats::default()
-    };
+    render_pass(scene, settings, 0, progress)
+}
+
+/// Pass `pass` of a render: its own photons and camera samples, and (for
+/// photon mapping) the estimates of [`Estimates::progressive`], which for
+/// pass 0 are the classic ones. A one-pass render is pass 0.
+fn render_pass(scene: &Scene, settings: &Settings, pass: u32, progress: Mode) -> (Film, Stats) {
+    let mut stats = Stats { passes: 1, ..Stats::default() };
     let (film, tally, camera_time) = match settings.method {
         Method::Photon => {
-            let est = Estimates::classic(scene, settings);
-            let maps = photon_pass(scene, settings, 0, est, progress, &mut stats);
+            let est = Estimates::progressive(scene, settings, pass);
+            (stats.r_global, stats.r_caustic, stats.k_global, stats.k_caustic) =
+                (est.r_global, est.r_caustic, est.k_global, est.k_caustic);
+            let maps = photon_pass(scene, settings, pass as u64, est, progress, &mut stats);
             let integrator = photon_integrator(scene, settings, &maps, est);
-            timed(|| camera_pass(scene, settings, &integrator, 0, progress))
+            timed(|| camera_pass(scene, settings, &integrator, pass as u64, progress))
         }
         Method::Path => {
             let integrator = PathIntegrator { scene, shadow_rays: settings.shadow_rays, skip: settings.skip };
-            timed(|| camera_pass(scene, settings, &integrator, 0, progress))
+            timed(|| camera_pass(scene, settings, &integrator, pass as u64, progress))
         }
     };
     stats.camera_time = camera_time;
@@ -382,29 +374,7 @@ pub fn render_progressive(
             break;
         }
         let t = Instant::now();
-        let mut pass_stats = Stats { passes: 1, ..Stats::default() };
-        let (film, tally, camera_time) = match settings.method {
-            Method::Photon => {
-                let est = Estimates::progressive(scene, settings, pass);
-                pass_stats.r_global = est.r_global;
-                pass_stats.r_caustic = est.r_caustic;
-                pass_stats.k_global = est.k_global;
-                pass_stats.k_caustic = est.k_caustic;
-                let maps = photon_pass(scene, settings, pass as u64, est, Mode::Quiet, &mut pass_stats);
-                let integrator = photon_integrator(scene, settings, &maps, est);
-                timed(|| camera_pass(scene, settings, &integrator, pass as u64, Mode::Quiet))
-            }
-            Method::Path => {
-                let integrator = PathIntegrator { scene, shadow_rays: settings.shadow_rays, skip: settings.skip };
-                timed(|| camera_pass(scene, settings, &integrator, pass as u64, Mode::Quiet))
-            }
-        };
-        pass_stats.camera_time = camera_time;
-        pass_stats.camera_rays = tally.rays;
-        pass_stats.nonfinite = tally.nonfinite;
-        pass_stats.first_nonfinite = tally.first_nonfinite;
-        pass_stats.edge_pixels = tally.edge_pixels;
-        pass_stats.shadow_rays_skipped = tally.shadow_rays_skipped;
+        let (film, pass_stats) = render_pass(scene, settings, pass, Mode::Quiet);
         stats.absorb(pass_stats);
         for (acc, px) in sum.iter_mut().zip(&film.pixels) {
             *acc += px.as_dvec3();

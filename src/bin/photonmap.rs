@@ -75,11 +75,12 @@ struct Cli {
     /// Image height in pixels.
     #[arg(long, default_value_t = 800, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     height: u32,
-    /// Nearest photons per global-map irradiance estimate.
-    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    /// Nearest photons per global-map irradiance estimate (at least 2: the
+    /// estimate counts those strictly inside the k-th photon's distance).
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(2..=100_000))]
     k: u32,
-    /// Nearest photons per caustic estimate.
-    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    /// Nearest photons per caustic estimate (at least 2).
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(2..=100_000))]
     k_caustic: u32,
     /// Largest search radius of a global-map estimate, in scene units
     /// [default: 5% of the scene's diagonal].
