@@ -23,8 +23,8 @@ impl Camera {
     /// (0,-1,1), i.e. lower-right, lower-left, upper-left, upper-right as seen
     /// from the eye (+y is to the left of the picture).
     pub fn from_corners(eye: Vertex, corners: [Vertex; 4], width: u32, height: u32) -> Self {
-        let [lower_right, lower_left, upper_left, upper_right] = corners;
-        let _ = lower_right;
+        // The lower-right corner is implied by the other three (a rectangle).
+        let [_, lower_left, upper_left, upper_right] = corners;
         Camera { eye, upper_left, across: upper_right - upper_left, down: lower_left - upper_left, width, height }
     }
 
