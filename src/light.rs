@@ -67,10 +67,6 @@ impl DiskLight {
         let p = self.sample_point(u_pos).point;
         Ray::new(p, self.frame.to_world(cosine_hemisphere(u_dir)).normalize())
     }
-
-    pub fn frame(&self) -> &Frame {
-        &self.frame
-    }
 }
 
 #[cfg(test)]

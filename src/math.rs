@@ -96,8 +96,3 @@ pub fn offset_ray_origin(p: Vertex, p_err: Vec3, n: Vec3, dir: Direction) -> Ver
 pub fn max_component(c: Color) -> f32 {
     c.x.max(c.y).max(c.z)
 }
-
-/// Mean of the three channels.
-pub fn luminance_mean(c: Color) -> f32 {
-    (c.x + c.y + c.z) / 3.0
-}
