@@ -1,24 +1,62 @@
-//! Lights. The default scene has one: a one-sided Lambertian disk.
-//! Each light can be sampled by area for shadow rays and can emit photons;
-//! both use the same geometry so they agree on its power.
+//! Lights: a closed set. Area lights (a one-sided Lambertian disk, or any
+//! triangle made emissive) are primitives too: camera rays see them and
+//! photons stop on them. Point and directional lights are the Whitted
+//! course's delta lights: they are never hit, only sampled.
+//!
+//! Every light answers two questions with the same geometry, so that shadow
+//! rays and photons agree on its power: the light arriving at a point from a
+//! sample of the light ([`Light::incident`]), and where a photon starts
+//! ([`Light::emit`]).
 
 use crate::math::{Color, Frame, Ray, Vertex};
-use crate::sampling::{concentric_disk, cosine_hemisphere};
-use crate::shape::Disk;
+use crate::sampling::{concentric_disk, cosine_hemisphere, uniform_cone, uniform_triangle};
+use crate::shape::{Departure, Disk, Triangle};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
-/// A one-sided disk of constant radiance emitting along `disk.normal`.
+/// The surface of an area light.
 #[derive(Clone, Copy, Debug)]
-pub struct DiskLight {
-    pub disk: Disk,
+pub enum Emitting {
+    Disk(Disk),
+    Triangle(Triangle),
+}
+
+impl Emitting {
+    pub fn area(&self) -> f32 {
+        match self {
+            Emitting::Disk(d) => d.area(),
+            Emitting::Triangle(t) => t.area(),
+        }
+    }
+
+    /// The side that emits.
+    pub fn normal(&self) -> Vec3 {
+        match self {
+            Emitting::Disk(d) => d.normal,
+            Emitting::Triangle(t) => t.normal,
+        }
+    }
+
+    /// Any point of the surface (the plane's reference point).
+    pub fn anchor(&self) -> Vertex {
+        match self {
+            Emitting::Disk(d) => d.center,
+            Emitting::Triangle(t) => t.v0,
+        }
+    }
+}
+
+/// A one-sided Lambertian emitter of constant radiance.
+#[derive(Clone, Copy, Debug)]
+pub struct AreaLight {
+    pub surface: Emitting,
     pub radiance: Color,
-    /// Index of the disk's primitive in the scene (shadow rays ignore it).
+    /// Index of the surface's primitive in the scene (shadow rays ignore it).
     pub prim: u32,
     frame: Frame,
 }
 
-/// A point on a light, chosen for a shadow ray.
+/// A point on an area light, chosen for a shadow ray.
 #[derive(Clone, Copy, Debug)]
 pub struct LightSample {
     pub point: Vertex,
@@ -27,46 +65,165 @@ pub struct LightSample {
     pub pdf_area: f32,
 }
 
-impl DiskLight {
-    pub fn new(disk: Disk, radiance: Color, prim: u32) -> Self {
-        DiskLight { disk, radiance, prim, frame: Frame::from_normal(disk.normal) }
+impl AreaLight {
+    pub fn new(surface: Emitting, radiance: Color, prim: u32) -> Self {
+        AreaLight { surface, radiance, prim, frame: Frame::from_normal(surface.normal()) }
     }
 
     pub fn area(&self) -> f32 {
-        self.disk.area()
-    }
-
-    /// Total emitted power per channel: pi * A * L for a Lambertian emitter.
-    pub fn power(&self) -> Color {
-        PI * self.area() * self.radiance
+        self.surface.area()
     }
 
     /// Radiance leaving the light towards `-dir` for a ray travelling along
     /// `dir`; zero from the back side.
     pub fn radiance_towards(&self, dir: Vec3) -> Color {
-        if dir.dot(self.disk.normal) < 0.0 {
+        if dir.dot(self.surface.normal()) < 0.0 {
             self.radiance
         } else {
             Color::ZERO
         }
     }
 
-    /// Uniform point on the disk (pdf 1 / area).
+    /// Uniform point on the surface (pdf 1 / area).
     pub fn sample_point(&self, u: Vec2) -> LightSample {
-        let d = concentric_disk(u) * self.disk.radius;
-        LightSample {
-            point: self.disk.center + self.frame.s * d.x + self.frame.t * d.y,
-            normal: self.disk.normal,
-            pdf_area: 1.0 / self.area(),
+        let point = match self.surface {
+            Emitting::Disk(disk) => {
+                let d = concentric_disk(u) * disk.radius;
+                disk.center + self.frame.s * d.x + self.frame.t * d.y
+            }
+            Emitting::Triangle(t) => {
+                let b = uniform_triangle(u);
+                t.v0 * (1.0 - b.x - b.y) + t.v1 * b.x + t.v2 * b.y
+            }
+        };
+        LightSample { point, normal: self.surface.normal(), pdf_area: 1.0 / self.area() }
+    }
+}
+
+/// Light arriving at a point from one sample of a light.
+#[derive(Clone, Copy, Debug)]
+pub struct Incident {
+    /// Unit direction from the point towards the light sample.
+    pub dir: Vec3,
+    /// Where the shadow ray ends: the sample point (`None`: a directional
+    /// light, unoccluded only if nothing lies anywhere along `dir`).
+    pub target: Option<Vertex>,
+    /// What multiplies BRDF x cos at the point: for an area light
+    /// L cos_l / (d^2 pdf_A), for a point light I / (d + d0)^falloff, for a
+    /// directional light its irradiance. The course's `I`.
+    pub intensity: Color,
+    /// The light's own primitive, which the shadow ray must not count.
+    pub prim: Option<u32>,
+}
+
+/// A light of the scene.
+#[derive(Clone, Copy, Debug)]
+pub enum Light {
+    Area(AreaLight),
+    /// Emits `intensity` (W/sr) equally in every direction; the Whitted
+    /// course dims it as 1 / (d + dead_distance)^falloff (physical: 2, 0).
+    Point { position: Vertex, intensity: Color, falloff: f32, dead_distance: f32 },
+    /// Parallel light travelling along unit `direction`, of irradiance
+    /// `irradiance` on a surface facing it. Photons start on a disk facing
+    /// the light that covers the scene (`reach`: its centre and radius).
+    Directional { direction: Vec3, irradiance: Color, reach: (Vertex, f32) },
+}
+
+impl Light {
+    /// Whether the light is an ideal point or direction: one sample is exact.
+    pub fn is_delta(&self) -> bool {
+        !matches!(self, Light::Area(_))
+    }
+
+    /// The area light, if this is one.
+    pub fn area(&self) -> Option<&AreaLight> {
+        match self {
+            Light::Area(a) => Some(a),
+            _ => None,
         }
     }
 
-    /// A photon's start: uniform position, cosine-distributed direction. With
-    /// these pdfs every photon of N carries exactly power / N.
-    pub fn emit(&self, u_pos: Vec2, u_dir: Vec2) -> Ray {
-        let p = self.sample_point(u_pos).point;
-        Ray::new(p, self.frame.to_world(cosine_hemisphere(u_dir)).normalize())
+    /// Whether every sample of the light certainly sends nothing to `p`: the
+    /// emitting side of a one-sided area light faces away from it.
+    pub fn faces_away(&self, p: Vertex) -> bool {
+        match self {
+            Light::Area(a) => (p - a.surface.anchor()).dot(a.surface.normal()) <= 0.0,
+            _ => false,
+        }
     }
+
+    /// Light arriving at `p` from the sample `u` of the light; `None` when
+    /// that sample sends nothing towards `p`.
+    pub fn incident(&self, p: Vertex, u: Vec2) -> Option<Incident> {
+        match *self {
+            Light::Area(a) => {
+                let s = a.sample_point(u);
+                let to = s.point - p;
+                let dist2 = to.length_squared();
+                if !(dist2 > 0.0) {
+                    return None;
+                }
+                let dir = to / dist2.sqrt();
+                let cos_l = -dir.dot(s.normal);
+                if !(cos_l > 0.0) {
+                    return None;
+                }
+                let intensity = a.radiance * (cos_l / (dist2 * s.pdf_area));
+                Some(Incident { dir, target: Some(s.point), intensity, prim: Some(a.prim) })
+            }
+            Light::Point { position, intensity, falloff, dead_distance } => {
+                let to = position - p;
+                let dist = to.length();
+                if !(dist > 0.0) {
+                    return None;
+                }
+                let scale = (dist + dead_distance).powf(-falloff);
+                let intensity = intensity * scale;
+                intensity.is_finite().then_some(Incident { dir: to / dist, target: Some(position), intensity, prim: None })
+            }
+            Light::Directional { direction, irradiance, .. } => {
+                Some(Incident { dir: -direction, target: None, intensity: irradiance, prim: None })
+            }
+        }
+    }
+
+    /// Total emitted power per channel.
+    pub fn power(&self) -> Color {
+        match *self {
+            Light::Area(a) => PI * a.area() * a.radiance,
+            Light::Point { intensity, .. } => 4.0 * PI * intensity,
+            Light::Directional { irradiance, reach, .. } => PI * reach.1 * reach.1 * irradiance,
+        }
+    }
+
+    /// A photon's start with the light's natural distribution (area lights:
+    /// uniform position, cosine direction; point lights: uniform direction;
+    /// directional: uniform on the covering disk). With these pdfs every
+    /// photon of N carries exactly power / N. The departure names the
+    /// light's primitive, if it has one.
+    pub fn emit(&self, u_pos: Vec2, u_dir: Vec2) -> (Ray, Option<Departure>) {
+        match *self {
+            Light::Area(a) => {
+                let p = a.sample_point(u_pos).point;
+                let dir = a.frame.to_world(cosine_hemisphere(u_dir)).normalize();
+                (Ray::new(p, dir), Some(Departure { prim: a.prim, outward: true }))
+            }
+            Light::Point { position, .. } => (Ray::new(position, uniform_cone(u_dir, -1.0).normalize()), None),
+            Light::Directional { direction, reach, .. } => {
+                let frame = Frame::from_normal(direction);
+                let d = concentric_disk(u_pos) * reach.1;
+                (Ray::new(reach.0 + frame.s * d.x + frame.t * d.y, direction), None)
+            }
+        }
+    }
+}
+
+/// The disk from which a directional light's photons start: facing the
+/// light, centred on the scene's bounding sphere, outside it.
+pub fn directional_reach(direction: Vec3, lo: Vec3, hi: Vec3) -> (Vertex, f32) {
+    let center = (lo + hi) * 0.5;
+    let radius = ((hi - lo) * 0.5).length().max(f32::MIN_POSITIVE) * 1.001;
+    (center - direction * (2.0 * radius), radius)
 }
 
 #[cfg(test)]
@@ -77,24 +234,20 @@ mod tests {
     /// E = pi L r^2 / (r^2 + h^2). Estimate it by area sampling.
     #[test]
     fn disk_irradiance_on_axis_matches_closed_form() {
-        let light = DiskLight::new(
-            Disk { center: Vec3::new(8.0, 0.0, 4.999), normal: -Vec3::Z, radius: 1.0 },
+        let light = Light::Area(AreaLight::new(
+            Emitting::Disk(Disk { center: Vec3::new(8.0, 0.0, 4.999), normal: -Vec3::Z, radius: 1.0 }),
             Color::splat(10.0),
             0,
-        );
+        ));
         let mut rng = crate::sampling::stream(7, crate::sampling::Domain::Camera, 0);
         for h in [0.5f32, 2.0, 9.999] {
-            let x = light.disk.center - h * Vec3::Z;
+            let x = Vec3::new(8.0, 0.0, 4.999) - h * Vec3::Z;
             let n = 200_000;
             let mut sum = 0.0f64;
             for _ in 0..n {
-                let s = light.sample_point(crate::sampling::next_2d(&mut rng));
-                let d = s.point - x;
-                let dist2 = d.length_squared();
-                let w = d / dist2.sqrt();
-                let cos_x = w.dot(Vec3::Z);
-                let cos_l = (-w).dot(s.normal);
-                sum += (10.0 * cos_x * cos_l / dist2 / s.pdf_area) as f64;
+                if let Some(inc) = light.incident(x, crate::sampling::next_2d(&mut rng)) {
+                    sum += (inc.intensity.x * inc.dir.dot(Vec3::Z)) as f64;
+                }
             }
             let est = sum / n as f64;
             let exact = (PI * 10.0 / (1.0 + h * h)) as f64;
@@ -104,5 +257,37 @@ mod tests {
         let h = 4.999f64 + 5.0;
         let floor = 0.8 / std::f64::consts::PI * std::f64::consts::PI * 10.0 / (1.0 + h * h);
         assert!((floor - 0.07922).abs() < 1e-4);
+    }
+
+    /// An emissive triangle: irradiance at a point far away approaches
+    /// L A cos / d^2, and the samples cover the triangle uniformly (mean at
+    /// the centroid).
+    #[test]
+    fn triangle_light_samples_uniformly_and_matches_far_field() {
+        let t = Triangle::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 2.0, 0.0));
+        let light = AreaLight::new(Emitting::Triangle(t), Color::ONE, 0);
+        let mut rng = crate::sampling::stream(3, crate::sampling::Domain::Camera, 1);
+        let n = 100_000;
+        let mut mean = Vec3::ZERO;
+        for _ in 0..n {
+            mean += light.sample_point(crate::sampling::next_2d(&mut rng)).point;
+        }
+        mean /= n as f32;
+        let centroid = (t.v0 + t.v1 + t.v2) / 3.0;
+        assert!((mean - centroid).length() < 0.01, "{mean} vs {centroid}");
+        let x = centroid + t.normal * 1000.0;
+        let inc = Light::Area(light).incident(x, Vec2::splat(0.3)).unwrap();
+        let want = 1.0 / 1000.0f32.powi(2);
+        assert!((inc.intensity.x - want).abs() < 1e-3 * want);
+        // From behind, nothing.
+        assert!(Light::Area(light).incident(centroid - t.normal, Vec2::splat(0.3)).is_none());
+    }
+
+    #[test]
+    fn point_light_dims_with_the_course_falloff() {
+        let l = Light::Point { position: Vec3::ZERO, intensity: Color::splat(8.0), falloff: 1.0, dead_distance: 2.0 };
+        let inc = l.incident(Vec3::new(0.0, 6.0, 0.0), Vec2::ZERO).unwrap();
+        assert!((inc.intensity.x - 1.0).abs() < 1e-6);
+        assert!((inc.dir + Vec3::Y).length() < 1e-6);
     }
 }

@@ -83,6 +83,13 @@ pub fn uniform_cone_pdf(cos_max: f32) -> f32 {
     1.0 / (2.0 * PI * (1.0 - cos_max))
 }
 
+/// Uniform point on a triangle as barycentrics (b1, b2) of v1 and v2
+/// (pdf 1 / area); the square-root warp (Shirley & Chiu).
+pub fn uniform_triangle(u: Vec2) -> Vec2 {
+    let su = u.x.sqrt();
+    Vec2::new(su * (1.0 - u.y), su * u.y)
+}
+
 /// The `index`-th of `n` jittered strata of [0,1)^2 (an `m x m` grid when `n`
 /// is a square; otherwise `n` strata along a line, still jittered).
 pub fn stratified_2d(index: u32, n: u32, u: Vec2) -> Vec2 {

@@ -11,7 +11,7 @@
 //! ignores genuinely close surfaces.
 
 use crate::math::{gamma, Ray, Vertex};
-use glam::Vec3;
+use glam::{Affine3A, Vec3};
 
 /// Where a ray started: the primitive it left and whether it left along the
 /// primitive's geometric normal (`outward`) or against it.
@@ -319,12 +319,79 @@ impl Disk {
     }
 }
 
+/// The assignment's transformed unit sphere: `to_world` maps the unit sphere
+/// at the origin onto the shape (an ellipsoid under non-uniform scale). A ray
+/// is carried into object space, met there by the unit sphere, and the hit's
+/// normal is carried back by the inverse transpose.
+#[derive(Clone, Copy, Debug)]
+pub struct Ellipsoid {
+    pub to_world: Affine3A,
+    to_object: Affine3A,
+}
+
+impl Ellipsoid {
+    /// `None` when the transform is singular (it would flatten the sphere).
+    pub fn new(to_world: Affine3A) -> Option<Self> {
+        let det = to_world.matrix3.determinant();
+        if !(det.abs() > 0.0) || !to_world.is_finite() {
+            return None;
+        }
+        let to_object = to_world.inverse();
+        to_object.is_finite().then_some(Ellipsoid { to_world, to_object })
+    }
+
+    /// The ray in object space with a unit direction, and the factor that
+    /// turns an object-space distance back into the world ray's parameter.
+    #[inline]
+    fn object_ray(&self, ray: &Ray) -> Option<(Ray, f32)> {
+        let d = self.to_object.transform_vector3(ray.dir);
+        let len = d.length();
+        if !(len > 0.0) || !len.is_finite() {
+            return None;
+        }
+        Some((Ray::new(self.to_object.transform_point3(ray.origin), d / len), len))
+    }
+
+    #[inline]
+    pub fn distance(&self, ray: &Ray, t_max: f32, departed: Option<bool>) -> Option<f32> {
+        let (local, len) = self.object_ray(ray)?;
+        let unit = Sphere { center: Vec3::ZERO, radius: 1.0 };
+        // The affine map keeps a line's parameter; only the unit-length
+        // normalisation in object space rescales it.
+        unit.distance(&local, t_max * len, departed).map(|t| t / len)
+    }
+
+    pub fn record(&self, ray: &Ray, t: f32) -> ShapeHit {
+        let (local_ray, len) = self.object_ray(ray).unwrap_or((*ray, 1.0));
+        let unit = Sphere { center: Vec3::ZERO, radius: 1.0 }.record(&local_ray, t * len);
+        let local = unit.point;
+        let point = self.to_world.transform_point3(local);
+        let m = self.to_world.matrix3;
+        let abs_m = glam::Mat3A::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
+        // The object point's error carried through the matrix, plus the
+        // rounding of the matrix product and the translation.
+        let p_err = Vec3::from(abs_m * glam::Vec3A::from(unit.p_err + gamma(4) * local.abs()))
+            + gamma(4) * (Vec3::from(abs_m * glam::Vec3A::from(local.abs())) + Vec3::from(self.to_world.translation.abs()));
+        let normal = (self.to_object.matrix3.transpose() * glam::Vec3A::from(local)).normalize();
+        ShapeHit { t, point, p_err, normal: Vec3::from(normal) }
+    }
+
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        // Extent along axis i of the image of the unit sphere: |row i of M|.
+        let m = self.to_world.matrix3.transpose();
+        let e = Vec3::new(m.x_axis.length(), m.y_axis.length(), m.z_axis.length());
+        let c = Vec3::from(self.to_world.translation);
+        (c - e, c + e)
+    }
+}
+
 /// The geometry of one primitive.
 #[derive(Clone, Copy, Debug)]
 pub enum Shape {
     Triangle(Triangle),
     Sphere(Sphere),
     Disk(Disk),
+    Ellipsoid(Ellipsoid),
 }
 
 impl Shape {
@@ -344,6 +411,7 @@ impl Shape {
             Shape::Triangle(tri) => tri.distance(ray, rs, t_max).map(|(t, u, v)| (t, [u, v])),
             Shape::Disk(disk) => disk.distance(ray, t_max).map(|t| (t, [0.0; 2])),
             Shape::Sphere(s) => s.distance(ray, t_max, departed).map(|t| (t, [0.0; 2])),
+            Shape::Ellipsoid(e) => e.distance(ray, t_max, departed).map(|t| (t, [0.0; 2])),
         }
     }
 
@@ -353,6 +421,7 @@ impl Shape {
             Shape::Triangle(tri) => tri.record(t, uv[0], uv[1]),
             Shape::Disk(disk) => disk.record(ray, t),
             Shape::Sphere(s) => s.record(ray, t),
+            Shape::Ellipsoid(e) => e.record(ray, t),
         }
     }
 
@@ -366,6 +435,10 @@ impl Shape {
             }
             Shape::Sphere(s) => (s.center, s.radius),
             Shape::Disk(d) => (d.center, d.radius),
+            Shape::Ellipsoid(e) => {
+                let (lo, hi) = e.bounds();
+                (Vec3::from(e.to_world.translation), ((hi - lo) * 0.5).length())
+            }
         }
     }
 
@@ -379,6 +452,7 @@ impl Shape {
                 let e = d.radius * (Vec3::ONE - d.normal * d.normal).max(Vec3::ZERO).sqrt();
                 (d.center - e, d.center + e)
             }
+            Shape::Ellipsoid(e) => e.bounds(),
         }
     }
 }

@@ -10,7 +10,7 @@ use photonmap::metrics::compare;
 use photonmap::progress::Mode;
 use photonmap::render::{render, Settings};
 use photonmap::sampling::{next_2d, stream, Domain};
-use photonmap::scene::{Eye, Prim, Scene, SceneParts};
+use photonmap::scene::{Eye, LightSpec, Prim, Scene, SceneParts};
 use photonmap::shape::{Shape, Sphere, Triangle};
 use proptest::prelude::*;
 
@@ -265,7 +265,7 @@ fn glass_of_index_one_is_invisible() {
     };
     let mut index_one = Scene::tncg15_parts(Eye::One);
     let g = index_one.prims[glass_index(&index_one)].material as usize;
-    index_one.materials[g] = Material::Glass { ior: 1.0 };
+    index_one.materials[g] = Material::glass(1.0);
     let mut without = Scene::tncg15_parts(Eye::One);
     let gi = glass_index(&without);
     without.prims.remove(gi);
@@ -293,7 +293,7 @@ fn degenerate_input_renders_finite_images() {
     parts.prims.extend(degenerate.iter().map(|&shape| Prim { shape, material: grey }));
     // A zero-radius glass sphere (an aiming target with no size) and a floor
     // triangle duplicated with another material (coincident faces).
-    parts.materials.push(Material::Glass { ior: 1.5 });
+    parts.materials.push(Material::glass(1.5));
     let glass = parts.materials.len() as u32 - 1;
     parts
         .prims
@@ -305,7 +305,8 @@ fn degenerate_input_renders_finite_images() {
 
     for radiance in [0.0f32, 1e12] {
         let mut p = Scene::tncg15_parts(Eye::One);
-        p.lights[0].1 = Color::splat(radiance);
+        let LightSpec::Area { radiance: r, .. } = &mut p.lights[0] else { panic!() };
+        *r = Color::splat(radiance);
         let film = render_parts(p, &small(20_000));
         assert!(radiance > 0.0 || film.mean() == 0.0);
     }

@@ -6,7 +6,8 @@ use photonmap::material::Material;
 use photonmap::metrics::compare;
 use photonmap::progress::Mode;
 use photonmap::render::{render, Settings, Stats};
-use photonmap::scene::{Eye, Scene, SceneParts};
+use photonmap::light::Emitting;
+use photonmap::scene::{Eye, LightSpec, Scene, SceneParts};
 
 fn settings(skip: bool) -> Settings {
     Settings { photons: 50_000, caustic_photons: 50_000, width: 64, height: 64, skip, ..Settings::default() }
@@ -81,7 +82,8 @@ fn lights_facing_away_get_no_shadow_rays() {
     for flip in [false, true] {
         let mut parts = Scene::tncg15_parts(Eye::One);
         if flip {
-            parts.lights[0].0.normal = -parts.lights[0].0.normal;
+            let LightSpec::Area { surface: Emitting::Disk(disk), .. } = &mut parts.lights[0] else { panic!() };
+            disk.normal = -disk.normal;
         }
         let scene = Scene::from_parts(parts);
         let (on, s_on) = render(&scene, &settings(true), Mode::Quiet);

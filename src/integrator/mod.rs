@@ -14,7 +14,6 @@ use crate::photon::map::Scratch;
 use crate::sampling::{next_2d, stratified_2d, Rng};
 use crate::scene::{Hit, Scene};
 use glam::Vec3;
-use std::f32::consts::PI;
 
 /// Which part of the radiance a camera sample estimates. A pixel's value is
 /// the sum of what reaches the eye from a light's own surface (directly or
@@ -87,43 +86,51 @@ impl Tally {
     }
 }
 
-/// Light reaching a Lambertian point straight from the lights: `count`
-/// stratified area samples per light, each with a shadow ray,
-/// (rho / pi) * sum L cos_x cos_l / (d^2 pdf_A). With `skip`, a light whose
-/// emitting side faces away from the point (a one-sided disk seen from
-/// behind or edge-on, where every sample has cos_l <= 0) is not sampled.
-pub fn direct_light(scene: &Scene, hit: &Hit, n: Vec3, rho: Color, count: u32, skip: bool, ctx: &mut Context) -> Color {
+/// Light reflected at a surface point straight from the lights:
+/// sum over lights of f(w) I cos_x, averaged over `count` stratified samples
+/// of each area light (one sample of a point or directional light is exact),
+/// each with a shadow ray. `brdf(w)` is the BRDF for light arriving from
+/// unit `w` (towards the light); `n` is the normal on the viewer's side.
+/// With `skip`, a light whose emitting side faces away from the point (a
+/// one-sided area light seen from behind or edge-on, where every sample has
+/// cos_l <= 0) is not sampled.
+#[allow(clippy::too_many_arguments)]
+pub fn direct_light(
+    scene: &Scene,
+    hit: &Hit,
+    n: Vec3,
+    brdf: impl Fn(Vec3) -> Color,
+    count: u32,
+    skip: bool,
+    ctx: &mut Context,
+) -> Color {
     let mut sum = Color::ZERO;
     for light in &scene.lights {
-        if skip && (hit.point - light.disk.center).dot(light.disk.normal) <= 0.0 {
+        let count = if light.is_delta() { 1 } else { count };
+        if skip && light.faces_away(hit.point) {
             ctx.tally.shadow_rays_skipped += count as u64;
             continue;
         }
         let mut light_sum = Color::ZERO;
         for s in 0..count {
-            let sample = light.sample_point(stratified_2d(s, count, next_2d(ctx.rng)));
-            let to_light = sample.point - hit.point;
-            let dist2 = to_light.length_squared();
-            if !(dist2 > 0.0) {
+            let Some(inc) = light.incident(hit.point, stratified_2d(s, count, next_2d(ctx.rng))) else {
+                continue;
+            };
+            let cos_x = n.dot(inc.dir);
+            if !(cos_x > 0.0) {
                 continue;
             }
-            let w = to_light / dist2.sqrt();
-            let cos_x = n.dot(w);
-            let cos_l = -w.dot(sample.normal);
-            if cos_x <= 0.0 || cos_l <= 0.0 {
-                continue;
-            }
-            let (shadow, dep) = hit.spawn(w);
+            let (shadow, dep) = hit.spawn(inc.dir);
             ctx.tally.rays += 1;
-            let t_max = (sample.point - shadow.origin).length();
-            if scene.occluded(&shadow, Some(dep), t_max, Some(light.prim)) {
+            let t_max = inc.target.map_or(f32::INFINITY, |p| (p - shadow.origin).length());
+            if scene.occluded(&shadow, Some(dep), t_max, inc.prim) {
                 continue;
             }
-            light_sum += light.radiance * (cos_x * cos_l / (dist2 * sample.pdf_area));
+            light_sum += brdf(inc.dir) * inc.intensity * cos_x;
         }
         sum += light_sum / count.max(1) as f32;
     }
-    rho / PI * sum
+    sum
 }
 
 /// The two directions leaving a smooth dielectric, computed in the local

@@ -9,12 +9,13 @@
 //! Russian roulette on the path's throughput ends long paths without bias.
 
 use super::{direct_light, glass_branches, Context, Integrator, Part};
-use crate::material::Material;
+use crate::material::{Lobe, Material};
 use crate::math::{max_component, Color, Frame, Ray};
 use crate::optics::reflect;
 use crate::sampling::{cosine_hemisphere, next_2d};
 use crate::scene::Scene;
 use rand::RngExt;
+use std::f32::consts::PI;
 
 /// Russian roulette starts after this many bounces.
 const RR_DEPTH: u32 = 3;
@@ -41,6 +42,7 @@ impl Integrator for PathIntegrator<'_> {
         for depth in 0..MAX_DEPTH {
             ctx.tally.rays += 1;
             let Some(hit) = self.scene.intersect(&ray, departure) else { break };
+            throughput *= self.scene.transmittance(departure, hit.t);
             let wo = match *self.scene.material(hit.prim) {
                 Material::Emitter => {
                     let wanted = match part {
@@ -60,7 +62,7 @@ impl Integrator for PathIntegrator<'_> {
                         break;
                     }
                     let n = hit.facing_normal(ray.dir);
-                    let direct = direct_light(self.scene, &hit, n, rho, self.shadow_rays, self.skip, ctx);
+                    let direct = direct_light(self.scene, &hit, n, |_| rho / PI, self.shadow_rays, self.skip, ctx);
                     radiance += throughput * ctx.checked(direct, "path direct");
                     count_emission = false;
                     specular_chain = false;
@@ -68,13 +70,54 @@ impl Integrator for PathIntegrator<'_> {
                     throughput *= rho;
                     Frame::from_normal(n).to_world(cosine_hemisphere(next_2d(ctx.rng)))
                 }
+                Material::Phong(p) => {
+                    let n = hit.facing_normal(ray.dir);
+                    let mirror = || {
+                        let f = Frame::from_normal(n);
+                        f.to_world(reflect(f.to_local(-ray.dir)))
+                    };
+                    if part == Part::Emitted {
+                        // Only the mirror lobe continues a specular chain.
+                        if p.mirror <= 0.0 {
+                            break;
+                        }
+                        throughput *= p.mirror_rho();
+                        mirror()
+                    } else {
+                        let to_viewer = -ray.dir;
+                        let direct =
+                            direct_light(self.scene, &hit, n, |w| p.brdf(n, w, to_viewer), self.shadow_rays, self.skip, ctx);
+                        radiance += throughput * ctx.checked(direct, "path direct");
+                        let Some((lobe, prob)) = p.choose_lobe(ctx.rng.random::<f32>()) else { break };
+                        match lobe {
+                            Lobe::Mirror => {
+                                count_emission = true;
+                                throughput *= p.mirror_rho() / prob;
+                                mirror()
+                            }
+                            Lobe::Diffuse => {
+                                count_emission = false;
+                                specular_chain = false;
+                                throughput *= p.diffuse_rho() / prob;
+                                Frame::from_normal(n).to_world(cosine_hemisphere(next_2d(ctx.rng)))
+                            }
+                            Lobe::Glossy => {
+                                count_emission = false;
+                                specular_chain = false;
+                                let Some((dir, w)) = p.sample_glossy(n, to_viewer, next_2d(ctx.rng)) else { break };
+                                throughput *= w / prob;
+                                dir
+                            }
+                        }
+                    }
+                }
                 Material::Mirror { reflectance } => {
                     throughput *= reflectance;
                     count_emission = true;
                     let f = Frame::from_normal(hit.facing_normal(ray.dir));
                     f.to_world(reflect(f.to_local(-ray.dir)))
                 }
-                Material::Glass { ior } => {
+                Material::Glass { ior, .. } => {
                     count_emission = true;
                     let b = glass_branches(&hit, &ray, ior);
                     match b.refracted {

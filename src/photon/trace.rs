@@ -7,10 +7,12 @@
 //! number of threads.
 
 use super::Photon;
-use crate::material::Material;
+use crate::material::{Lobe, Material};
 use crate::math::{max_component, Color, Frame, Ray};
 use crate::optics::{fresnel_dielectric, reflect, refract};
-use crate::sampling::{cosine_hemisphere, next_2d, stream, uniform_cone, uniform_cone_pdf, Domain, Rng};
+use crate::light::Light;
+use crate::sampling::{concentric_disk, cosine_hemisphere, next_2d, stream, uniform_cone, uniform_cone_pdf, Domain, Rng};
+use std::f32::consts::PI;
 use crate::scene::Scene;
 use crate::shape::Departure;
 use glam::Vec3;
@@ -91,42 +93,51 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
 
 /// Picks a light in proportion to its power (one light: always it) and
 /// starts a photon from it. Returns the ray, its departure and its power.
-fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> Option<(Ray, Departure, Color)> {
-    let total = max_component(scene.emitted_power());
-    let mut pick = rng.random::<f32>() * total;
-    let mut light = &scene.lights[0];
-    for l in &scene.lights {
-        light = l;
-        pick -= max_component(l.power());
-        if pick < 0.0 {
-            break;
-        }
-    }
-    let p_light = max_component(light.power()) / total;
-    if !(p_light > 0.0) {
-        return None;
-    }
-    let departure = Departure { prim: light.prim, outward: true };
+fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> Option<(Ray, Option<Departure>, Color)> {
+    let (light, p_light) = scene.pick_light(rng.random::<f32>())?;
+    let scale = 1.0 / (p_light * n as f32);
     match pass {
         Pass::Global => {
-            // Uniform position, cosine direction: each photon carries power / n.
-            let ray = light.emit(next_2d(rng), next_2d(rng));
-            Some((ray, departure, light.power() / (p_light * n as f32)))
+            // The light's natural distribution: each photon carries power / n.
+            let (ray, departure) = light.emit(next_2d(rng), next_2d(rng));
+            Some((ray, departure, light.power() * scale))
         }
         Pass::Caustic => {
-            // Uniform position, direction uniform in the cone of one specular
-            // object's bounding sphere; the power is L cos / (pdf_A pdf_w n),
-            // pdf_w being the mixture over all cones that contain the direction.
             let targets = scene.specular_targets();
-            let origin = light.sample_point(next_2d(rng)).point;
             let chosen_index = ((rng.random::<f32>() * targets.len() as f32) as usize).min(targets.len() - 1);
             let chosen = &targets[chosen_index];
+            if let Light::Directional { direction, irradiance, reach } = *light {
+                // Parallel light: start uniformly on the disk the chosen
+                // object's bounding sphere casts on the emission plane; the
+                // power is E / (pdf_A n), pdf_A the mixture over all disks.
+                let frame = Frame::from_normal(direction);
+                let project = |c: Vec3| c - direction * (c - reach.0).dot(direction);
+                let d = concentric_disk(next_2d(rng)) * chosen.radius;
+                let origin = project(chosen.center) + frame.s * d.x + frame.t * d.y;
+                let pdf_area: f32 = targets
+                    .iter()
+                    .enumerate()
+                    .map(|(j, t)| {
+                        let inside = (origin - project(t.center)).length_squared() <= t.radius * t.radius;
+                        if j == chosen_index || inside {
+                            1.0 / (PI * t.radius * t.radius)
+                        } else {
+                            0.0
+                        }
+                    })
+                    .sum::<f32>()
+                    / targets.len() as f32;
+                return Some((Ray::new(origin, direction), None, irradiance * scale / pdf_area));
+            }
+            // Direction uniform in the cone of one specular object's bounding
+            // sphere; pdf_w is the mixture over all cones that contain it.
+            let (origin, departure) = match light {
+                Light::Area(a) => (a.sample_point(next_2d(rng)).point, Some(Departure { prim: a.prim, outward: true })),
+                Light::Point { position, .. } => (*position, None),
+                Light::Directional { .. } => unreachable!("handled above"),
+            };
             let (axis, cos_max) = cone_towards(origin, chosen.center, chosen.radius);
             let dir = Frame::from_normal(axis).to_world(uniform_cone(next_2d(rng), cos_max)).normalize();
-            let cos_emit = dir.dot(light.disk.normal);
-            if !(cos_emit > 0.0) {
-                return None;
-            }
             // The direction lies in the chosen cone by construction (a test
             // could deny it by rounding at the rim and leave a zero pdf); the
             // other cones count where they contain it.
@@ -143,8 +154,20 @@ fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> Option<(Ray, Depart
                 })
                 .sum::<f32>()
                 / targets.len() as f32;
-            let power = light.radiance * cos_emit * light.area() / (pdf_dir * p_light * n as f32);
-            Some((Ray::new(origin, dir), departure, power))
+            // Radiant intensity towards `dir`: L cos A for an area light
+            // (sampled by area), I for a point light.
+            let intensity = match light {
+                Light::Area(a) => {
+                    let cos_emit = dir.dot(a.surface.normal());
+                    if !(cos_emit > 0.0) {
+                        return None;
+                    }
+                    a.radiance * cos_emit * a.area()
+                }
+                Light::Point { intensity, .. } => *intensity,
+                Light::Directional { .. } => unreachable!("handled above"),
+            };
+            Some((Ray::new(origin, dir), departure, intensity * scale / pdf_dir))
         }
     }
 }
@@ -171,7 +194,7 @@ fn follow(
     scene: &Scene,
     pass: Pass,
     mut ray: Ray,
-    mut departure: Departure,
+    mut departure: Option<Departure>,
     mut power: Color,
     rng: &mut Rng,
     out: &mut Vec<Photon>,
@@ -181,9 +204,10 @@ fn follow(
     let mut result = Followed { rays: 0, first_hit_specular: false };
     for bounce in 0..MAX_BOUNCES {
         result.rays += 1;
-        let Some(hit) = scene.intersect(&ray, Some(departure)) else {
+        let Some(hit) = scene.intersect(&ray, departure) else {
             break;
         };
+        power *= scene.transmittance(departure, hit.t);
         let n = hit.facing_normal(ray.dir);
         let material = *scene.material(hit.prim);
         if bounce == 0 {
@@ -218,12 +242,51 @@ fn follow(
                 only_specular_so_far = false;
                 cosine_hemisphere(next_2d(rng))
             }
+            Material::Phong(p) => {
+                // The Lambertian lobe stores photons as a Lambertian surface
+                // does; roulette then picks the lobe that carries the photon on.
+                let rho = p.diffuse_rho();
+                let store = max_component(rho) > 0.0;
+                match pass {
+                    Pass::Caustic if store && only_specular_so_far && specular_bounces > 0 => {
+                        out.push(Photon::new(hit.point, power, n, -ray.dir));
+                    }
+                    Pass::Global if store => out.push(Photon::new(hit.point, power, n, -ray.dir)),
+                    _ => {}
+                }
+                let Some((lobe, prob)) = p.choose_lobe(rng.random::<f32>()) else {
+                    break;
+                };
+                match lobe {
+                    Lobe::Mirror => {
+                        power *= p.mirror_rho() / prob;
+                        specular_bounces += 1;
+                        reflect(wi)
+                    }
+                    // A caustic path ends at its first non-specular bounce.
+                    _ if pass == Pass::Caustic => break,
+                    Lobe::Diffuse => {
+                        power *= rho / prob;
+                        only_specular_so_far = false;
+                        cosine_hemisphere(next_2d(rng))
+                    }
+                    Lobe::Glossy => {
+                        only_specular_so_far = false;
+                        // Sampled in world space around the mirror direction.
+                        let Some((dir, w)) = p.sample_glossy(n, -ray.dir, next_2d(rng)) else {
+                            break;
+                        };
+                        power *= w / prob;
+                        frame.to_local(dir)
+                    }
+                }
+            }
             Material::Mirror { reflectance } => {
                 power *= reflectance;
                 specular_bounces += 1;
                 reflect(wi)
             }
-            Material::Glass { ior } => {
+            Material::Glass { ior, .. } => {
                 specular_bounces += 1;
                 let entering = ray.dir.dot(hit.normal) < 0.0;
                 let (n_i, n_t) = if entering { (1.0, ior) } else { (ior, 1.0) };
@@ -240,7 +303,8 @@ fn follow(
             break;
         }
         let dir = frame.to_world(wo).normalize();
-        (ray, departure) = hit.spawn(dir);
+        let (next, dep) = hit.spawn(dir);
+        (ray, departure) = (next, Some(dep));
     }
     result
 }
@@ -281,7 +345,8 @@ mod tests {
     #[test]
     fn a_light_of_radiance_zero_emits_no_photons() {
         let mut parts = Scene::tncg15_parts(Eye::One);
-        parts.lights[0].1 = crate::math::Color::ZERO;
+        let crate::scene::LightSpec::Area { radiance, .. } = &mut parts.lights[0] else { panic!() };
+        *radiance = crate::math::Color::ZERO;
         let scene = Scene::from_parts(parts);
         for pass in [Pass::Global, Pass::Caustic] {
             let out = trace_pass(&scene, pass, 1000, 1, &|_| {});

@@ -5,10 +5,13 @@
 
 use crate::accel::Accel;
 use crate::camera::Camera;
-use crate::light::DiskLight;
+use crate::light::{directional_reach, AreaLight, Emitting, Light};
 use crate::material::Material;
-use crate::math::{offset_ray_origin, Color, Ray, Vertex};
-use crate::shape::{tetrahedron, Departure, Disk, Shape, Sphere, Triangle};
+use crate::math::{max_component, offset_ray_origin, Color, Ray, Vertex};
+pub mod file;
+pub mod mesh;
+
+use crate::shape::{tetrahedron, Departure, Disk, Ellipsoid, Shape, Sphere, Triangle};
 use glam::{Vec2, Vec3};
 
 /// One primitive: its geometry and the index of its material.
@@ -65,13 +68,27 @@ pub struct Target {
 pub struct Scene {
     pub prims: Vec<Prim>,
     pub materials: Vec<Material>,
-    pub lights: Vec<DiskLight>,
+    pub lights: Vec<Light>,
+    /// The Whitted course's ambient light A (photonmap requires zero).
+    pub ambient: Color,
     pub camera: Camera,
     /// Light index per primitive (`None` for non-emitters).
     light_of_prim: Vec<Option<u32>>,
     accel: Accel,
     bounds: (Vec3, Vec3),
     targets: Vec<Target>,
+    /// Running sum of the lights' powers (largest channel), for choosing one.
+    light_cdf: Vec<f32>,
+}
+
+/// A light as a scene describes it, before the scene places it.
+#[derive(Clone, Copy, Debug)]
+pub enum LightSpec {
+    /// A one-sided Lambertian emitter; it becomes a primitive of the scene.
+    Area { surface: Emitting, radiance: Color },
+    Point { position: Vertex, intensity: Color, falloff: f32, dead_distance: f32 },
+    /// Parallel light along unit `direction`.
+    Directional { direction: Vec3, irradiance: Color },
 }
 
 /// A scene's ingredients, before [`Scene::from_parts`] derives what the
@@ -80,8 +97,8 @@ pub struct Scene {
 pub struct SceneParts {
     pub prims: Vec<Prim>,
     pub materials: Vec<Material>,
-    /// Disk lights and their radiance.
-    pub lights: Vec<(Disk, Color)>,
+    pub lights: Vec<LightSpec>,
+    pub ambient: Color,
     pub camera: Camera,
 }
 
@@ -89,15 +106,30 @@ impl SceneParts {
     /// The same scene with every length multiplied by `s` (> 0). Radiance is
     /// per unit area and solid angle, so the image is unchanged.
     pub fn scaled(mut self, s: f32) -> Self {
+        let scale_triangle = |t: Triangle| Triangle::new(t.v0 * s, t.v1 * s, t.v2 * s);
+        let scale_disk = |d: Disk| Disk { center: d.center * s, radius: d.radius * s, ..d };
         for p in &mut self.prims {
             p.shape = match p.shape {
-                Shape::Triangle(t) => Shape::Triangle(Triangle::new(t.v0 * s, t.v1 * s, t.v2 * s)),
+                Shape::Triangle(t) => Shape::Triangle(scale_triangle(t)),
                 Shape::Sphere(sp) => Shape::Sphere(Sphere { center: sp.center * s, radius: sp.radius * s }),
-                Shape::Disk(d) => Shape::Disk(Disk { center: d.center * s, radius: d.radius * s, ..d }),
+                Shape::Disk(d) => Shape::Disk(scale_disk(d)),
+                Shape::Ellipsoid(e) => Shape::Ellipsoid(
+                    Ellipsoid::new(glam::Affine3A::from_scale(Vec3::splat(s)) * e.to_world).unwrap_or(e),
+                ),
             };
         }
-        for (d, _) in &mut self.lights {
-            *d = Disk { center: d.center * s, radius: d.radius * s, ..*d };
+        for l in &mut self.lights {
+            match l {
+                LightSpec::Area { surface: Emitting::Disk(d), .. } => *d = scale_disk(*d),
+                LightSpec::Area { surface: Emitting::Triangle(t), .. } => *t = scale_triangle(*t),
+                // Intensity (W/sr) gives irradiance I / d^2: keep the image by
+                // scaling it with the area.
+                LightSpec::Point { position, intensity, .. } => {
+                    *position *= s;
+                    *intensity *= s * s;
+                }
+                LightSpec::Directional { .. } => {}
+            }
         }
         self.camera = self.camera.scaled(s);
         self
@@ -113,21 +145,65 @@ pub enum Eye {
     Two,
 }
 
+/// The TNCG15 hexagonal room (notes/default-scene.md) as 24 triangles whose
+/// normals point into the room: floor and ceiling as fans of six around the
+/// hexagon's centre, then two triangles per wall, walls in the spec's order
+/// P0-P1 … P5-P0.
+pub fn tncg15_room(floor: u32, ceiling: u32, walls: [u32; 6]) -> Vec<Prim> {
+    let hexagon = [
+        Vec2::new(-3.0, 0.0),
+        Vec2::new(0.0, 6.0),
+        Vec2::new(10.0, 6.0),
+        Vec2::new(13.0, 0.0),
+        Vec2::new(10.0, -6.0),
+        Vec2::new(0.0, -6.0),
+    ];
+    let (floor_z, ceiling_z) = (-5.0, 5.0);
+    let mut prims = Vec::with_capacity(24);
+    let inside = Vec3::new(5.0, 0.0, 0.0);
+    let mut room_triangle = |a: Vec3, b: Vec3, c: Vec3, material: u32| {
+        let t = Triangle::new(a, b, c);
+        let t = if t.normal.dot(inside - a) < 0.0 { Triangle::new(a, c, b) } else { t };
+        prims.push(Prim { shape: Shape::Triangle(t), material });
+    };
+    let centre = Vec2::new(5.0, 0.0);
+    for (z, material) in [(floor_z, floor), (ceiling_z, ceiling)] {
+        for i in 0..6 {
+            let (a, b) = (hexagon[i], hexagon[(i + 1) % 6]);
+            room_triangle(centre.extend(z), a.extend(z), b.extend(z), material);
+        }
+    }
+    for (i, m) in walls.into_iter().enumerate() {
+        let (a, b) = (hexagon[i], hexagon[(i + 1) % 6]);
+        room_triangle(a.extend(floor_z), b.extend(floor_z), b.extend(ceiling_z), m);
+        room_triangle(a.extend(floor_z), b.extend(ceiling_z), a.extend(ceiling_z), m);
+    }
+    prims
+}
+
 impl Scene {
-    /// Assembles a scene; the disk lights are added as primitives too, so that
-    /// camera rays see them and photons are absorbed by them.
-    pub fn new(mut prims: Vec<Prim>, mut materials: Vec<Material>, lights: Vec<(Disk, Color)>, camera: Camera) -> Self {
+    /// Assembles a scene; the area lights are added as primitives too (after
+    /// `parts.prims`, in order), so that camera rays see them and photons are
+    /// absorbed by them.
+    pub fn from_parts(parts: SceneParts) -> Self {
+        let SceneParts { mut prims, mut materials, lights: specs, ambient, camera } = parts;
         let mut light_of_prim = vec![None; prims.len()];
-        let mut disk_lights = Vec::new();
-        if !lights.is_empty() {
+        let mut lights = Vec::new();
+        let emitter = materials.len() as u32;
+        if specs.iter().any(|l| matches!(l, LightSpec::Area { .. })) {
             materials.push(Material::Emitter);
         }
-        let emitter = materials.len() as u32 - 1;
-        for (disk, radiance) in lights {
-            let prim = prims.len() as u32;
-            prims.push(Prim { shape: Shape::Disk(disk), material: emitter });
-            light_of_prim.push(Some(disk_lights.len() as u32));
-            disk_lights.push(DiskLight::new(disk, radiance, prim));
+        for spec in &specs {
+            if let LightSpec::Area { surface, radiance } = *spec {
+                let prim = prims.len() as u32;
+                let shape = match surface {
+                    Emitting::Disk(d) => Shape::Disk(d),
+                    Emitting::Triangle(t) => Shape::Triangle(t),
+                };
+                prims.push(Prim { shape, material: emitter });
+                light_of_prim.push(Some(lights.len() as u32));
+                lights.push(Light::Area(AreaLight::new(surface, radiance, prim)));
+            }
         }
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
@@ -136,16 +212,45 @@ impl Scene {
             lo = lo.min(a);
             hi = hi.max(b);
         }
+        for spec in &specs {
+            match *spec {
+                LightSpec::Area { .. } => {}
+                LightSpec::Point { position, intensity, falloff, dead_distance } => {
+                    lo = lo.min(position);
+                    hi = hi.max(position);
+                    lights.push(Light::Point { position, intensity, falloff, dead_distance });
+                }
+                LightSpec::Directional { direction, irradiance } => {
+                    lights.push(Light::Directional { direction, irradiance, reach: (Vec3::ZERO, 0.0) });
+                }
+            }
+        }
+        if !(lo.x <= hi.x) {
+            (lo, hi) = (Vec3::ZERO, Vec3::ZERO);
+        }
+        // Directional photons start outside everything else.
+        for l in &mut lights {
+            if let Light::Directional { direction, reach, .. } = l {
+                *reach = directional_reach(*direction, lo, hi);
+            }
+        }
         let targets = prims
             .iter()
-            .filter(|p| materials[p.material as usize].is_specular())
+            .filter(|p| materials[p.material as usize].has_specular_lobe())
             .map(|p| {
                 let (center, radius) = p.shape.bounding_sphere();
                 Target { center, radius }
             })
             .collect();
         let accel = Accel::new(prims.iter().map(|p| p.shape).collect());
-        Scene { prims, materials, lights: disk_lights, camera, light_of_prim, accel, bounds: (lo, hi), targets }
+        let light_cdf = lights
+            .iter()
+            .scan(0.0f32, |acc, l| {
+                *acc += max_component(l.power());
+                Some(*acc)
+            })
+            .collect();
+        Scene { prims, materials, lights, ambient, camera, light_of_prim, accel, bounds: (lo, hi), targets, light_cdf }
     }
 
     /// The built-in TNCG15 room (see notes/default-scene.md), 800 x 800.
@@ -153,22 +258,9 @@ impl Scene {
         Scene::from_parts(Scene::tncg15_parts(eye))
     }
 
-    pub fn from_parts(p: SceneParts) -> Self {
-        Scene::new(p.prims, p.materials, p.lights, p.camera)
-    }
-
     /// The built-in room's primitives, materials, light and camera, before
     /// assembly: tests vary them (scale the scene, change a material).
     pub fn tncg15_parts(eye: Eye) -> SceneParts {
-        let hexagon = [
-            Vec2::new(-3.0, 0.0),
-            Vec2::new(0.0, 6.0),
-            Vec2::new(10.0, 6.0),
-            Vec2::new(13.0, 0.0),
-            Vec2::new(10.0, -6.0),
-            Vec2::new(0.0, -6.0),
-        ];
-        let (floor_z, ceiling_z) = (-5.0, 5.0);
         let grey = Color::splat(0.8);
         let wall_rho = [
             Color::new(0.80, 0.10, 0.80), // P0-P1 back-left, magenta
@@ -179,30 +271,13 @@ impl Scene {
             Color::new(0.10, 0.80, 0.80), // P5-P0 back-right, cyan
         ];
         let mut materials = vec![Material::Lambertian { rho: grey }];
-        let mut prims = Vec::new();
-        let inside = Vec3::new(5.0, 0.0, 0.0);
-        // Wind each room triangle so its normal points into the room.
-        let mut room_triangle = |a: Vec3, b: Vec3, c: Vec3, material: u32| {
-            let t = Triangle::new(a, b, c);
-            let t = if t.normal.dot(inside - a) < 0.0 { Triangle::new(a, c, b) } else { t };
-            prims.push(Prim { shape: Shape::Triangle(t), material });
-        };
-        // Floor and ceiling: a fan of six triangles around the hexagon's centre.
-        let centre = Vec2::new(5.0, 0.0);
-        for z in [floor_z, ceiling_z] {
-            for i in 0..6 {
-                let (a, b) = (hexagon[i], hexagon[(i + 1) % 6]);
-                room_triangle(centre.extend(z), a.extend(z), b.extend(z), 0);
-            }
+        let mut walls = [0u32; 6];
+        for (wall, rho) in walls.iter_mut().zip(wall_rho) {
+            materials.push(Material::Lambertian { rho });
+            *wall = materials.len() as u32 - 1;
         }
-        for (i, rho) in wall_rho.iter().enumerate() {
-            materials.push(Material::Lambertian { rho: *rho });
-            let m = materials.len() as u32 - 1;
-            let (a, b) = (hexagon[i], hexagon[(i + 1) % 6]);
-            room_triangle(a.extend(floor_z), b.extend(floor_z), b.extend(ceiling_z), m);
-            room_triangle(a.extend(floor_z), b.extend(ceiling_z), a.extend(ceiling_z), m);
-        }
-        materials.push(Material::Glass { ior: 1.5 });
+        let mut prims = tncg15_room(0, 0, walls);
+        materials.push(Material::glass(1.5));
         let glass = materials.len() as u32 - 1;
         prims.push(Prim {
             shape: Shape::Sphere(Sphere { center: Vec3::new(9.5, -2.0, -3.0), radius: 1.5 }),
@@ -241,7 +316,13 @@ impl Scene {
             800,
             800,
         );
-        SceneParts { prims, materials, lights: vec![(light, Color::splat(10.0))], camera }
+        SceneParts {
+            prims,
+            materials,
+            lights: vec![LightSpec::Area { surface: Emitting::Disk(light), radiance: Color::splat(10.0) }],
+            ambient: Color::ZERO,
+            camera,
+        }
     }
 
     pub fn intersect(&self, ray: &Ray, departure: Option<Departure>) -> Option<Hit> {
@@ -264,8 +345,22 @@ impl Scene {
         &self.materials[self.prims[prim as usize].material as usize]
     }
 
-    pub fn light_of(&self, prim: u32) -> Option<&DiskLight> {
-        self.light_of_prim[prim as usize].map(|i| &self.lights[i as usize])
+    /// The area light whose surface primitive `prim` is.
+    pub fn light_of(&self, prim: u32) -> Option<&AreaLight> {
+        self.light_of_prim[prim as usize].and_then(|i| self.lights[i as usize].area())
+    }
+
+    /// What is left of light that travelled `t` from a ray's `departure`:
+    /// less than one only inside absorbing glass (Beer–Lambert). A ray is
+    /// inside a glass body when it left the glass against its outward normal.
+    pub fn transmittance(&self, departure: Option<Departure>, t: f32) -> Color {
+        match departure {
+            Some(d) if !d.outward => match *self.material(d.prim) {
+                Material::Glass { absorption, .. } if absorption != Color::ZERO => (-absorption * t).exp(),
+                _ => Color::ONE,
+            },
+            _ => Color::ONE,
+        }
     }
 
     /// Axis-aligned bounds of all primitives.
@@ -278,9 +373,24 @@ impl Scene {
         (self.bounds.1 - self.bounds.0).length()
     }
 
-    /// Bounding spheres of the specular (mirror, glass) primitives.
+    /// Bounding spheres of the primitives with a mirror or glass lobe.
     pub fn specular_targets(&self) -> &[Target] {
         &self.targets
+    }
+
+    /// A light chosen by `u` in [0, 1) in proportion to its power (largest
+    /// channel), with the probability of that choice; `None` when no light
+    /// emits anything.
+    pub fn pick_light(&self, u: f32) -> Option<(&Light, f32)> {
+        let total = *self.light_cdf.last()?;
+        if !(total > 0.0) {
+            return None;
+        }
+        let x = u * total;
+        let i = self.light_cdf.partition_point(|&c| c <= x).min(self.lights.len() - 1);
+        let below = if i == 0 { 0.0 } else { self.light_cdf[i - 1] };
+        let p = (self.light_cdf[i] - below) / total;
+        (p > 0.0).then(|| (&self.lights[i], p))
     }
 
     /// Total emitted power per channel.
