@@ -1,4 +1,5 @@
-//! `photonmap`: renders the built-in TNCG15 room with photon mapping.
+//! `photonmap`: renders the built-in TNCG15 room, or a scene file, with
+//! photon mapping.
 //! A thin layer: parse and check the options, render, write, summarise.
 
 use clap::Parser;
@@ -20,9 +21,14 @@ use std::time::Instant;
     version,
     about,
     allow_negative_numbers = true,
-    after_help = "Example: photonmap --photons 1e6 out.exr -o out.png"
+    after_help = "Examples: photonmap --photons 1e6 out.exr -o out.png\n          photonmap --scene scenes/tncg15.toml out.exr"
 )]
 struct Cli {
+    /// Render this scene file (TOML, notes/scene-format.md) instead of the
+    /// built-in room; its camera, resolution and rays_per_pixel_edge are the
+    /// defaults of --width, --height and --spp.
+    #[arg(long, value_name = "SCENE.toml", conflicts_with = "eye")]
+    scene: Option<PathBuf>,
     /// Output images; the extension picks the format: .exr (linear float
     /// radiance), .png or .ppm (8-bit, tone-mapped).
     #[arg(value_name = "OUT")]
@@ -56,25 +62,27 @@ struct Cli {
     /// [default: the same as --photons].
     #[arg(long, value_parser = parse_count)]
     caustic_photons: Option<u64>,
-    /// Jittered camera samples per pixel (stratified when a square).
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
-    spp: u32,
+    /// Jittered camera samples per pixel (stratified when a square)
+    /// [default: 4, or rays_per_pixel_edge squared from a scene file].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    spp: Option<u32>,
     /// Seed of every random stream: the same seed gives the same image on any
     /// number of threads.
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Eye position: 1 = (-2,0,0), 53 degree view; 2 = (-1,0,0), 90 degrees.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
-    eye: u8,
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2))]
+    eye: Option<u8>,
     /// Worker threads [default: all cores].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     threads: Option<u32>,
-    /// Image width in pixels (the image plane stays the course's 2 x 2 square).
-    #[arg(long, default_value_t = 800, value_parser = clap::value_parser!(u32).range(1..=65_536))]
-    width: u32,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 800, value_parser = clap::value_parser!(u32).range(1..=65_536))]
-    height: u32,
+    /// Image width in pixels; the image plane stays the camera's [default:
+    /// 800, or the scene file's].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    width: Option<u32>,
+    /// Image height in pixels [default: 800, or the scene file's].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    height: Option<u32>,
     /// Nearest photons per global-map irradiance estimate (at least 2: the
     /// estimate counts those strictly inside the k-th photon's distance).
     #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(2..=100_000))]
@@ -194,15 +202,28 @@ fn run(cli: Cli) -> Result<(), Error> {
             .build_global()
             .map_err(|e| Error::Invalid(format!("--threads: {e}")))?;
     }
+    let (scene, file_spp) = match &cli.scene {
+        None => (Scene::tncg15(if cli.eye == Some(2) { Eye::Two } else { Eye::One }), 4),
+        Some(path) => {
+            let file = photonmap::scene::file::load(path).map_err(|e| Error::Invalid(e.to_string()))?;
+            if let Some(e) = file.not_physical.first() {
+                return Err(Error::Invalid(format!("{e} (the `trace` program renders this scene)")));
+            }
+            let n = file.rays_per_pixel_edge;
+            (Scene::from_parts(file.parts), n * n)
+        }
+    };
+    let width = cli.width.unwrap_or(scene.camera.width);
+    let height = cli.height.unwrap_or(scene.camera.height);
     let settings = Settings {
         method: cli.integrator,
         alpha: cli.alpha,
         photons: cli.photons,
         caustic_photons: cli.caustic_photons.unwrap_or(cli.photons),
-        spp: cli.spp,
+        spp: cli.spp.unwrap_or(file_spp),
         seed: cli.seed,
-        width: cli.width,
-        height: cli.height,
+        width,
+        height,
         k_global: cli.k as usize,
         k_caustic: cli.k_caustic as usize,
         r_global: cli.max_radius,
@@ -229,7 +250,6 @@ fn run(cli: Cli) -> Result<(), Error> {
             )));
         }
     }
-    let scene = Scene::tncg15(if cli.eye == 2 { Eye::Two } else { Eye::One });
     if settings.photons == 0 && !cli.quiet {
         eprintln!("photonmap: warning: --photons 0: no global map, so indirect light is missing");
     }

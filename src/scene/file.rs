@@ -39,6 +39,10 @@ pub struct SceneFile {
     pub parts: SceneParts,
     /// The n of the n x n jittered samples per pixel.
     pub rays_per_pixel_edge: u32,
+    /// Whitted-only features that a physically based renderer cannot
+    /// honour (ambient light, a falloff other than 1/d^2, a Phong material
+    /// that creates energy), located.
+    pub not_physical: Vec<SceneError>,
 }
 
 type V3 = [f32; 3];
@@ -157,7 +161,8 @@ pub fn load(path: &Path) -> Result<SceneFile, SceneError> {
 pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
     let src = Source { path, text };
     let def: FileDef = toml::from_str(text).map_err(|e| src.toml_error(&e))?;
-    Builder { src, materials: Vec::new(), names: BTreeMap::new(), prims: Vec::new(), lights: Vec::new() }.build(def)
+    Builder { src, materials: Vec::new(), names: BTreeMap::new(), prims: Vec::new(), lights: Vec::new(), not_physical: Vec::new() }
+        .build(def)
 }
 
 /// The text being read, for turning spans into lines and columns.
@@ -185,10 +190,10 @@ impl Source<'_> {
 
     fn field_at(&self, offset: usize) -> String {
         let offset = offset.min(self.text.len());
+        let line_start = self.text[..offset].rfind('\n').map_or(0, |i| i + 1);
         let mut table = String::new();
         let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-        let mut line_start = 0;
-        for line in self.text[..offset].split_inclusive('\n') {
+        for line in self.text[..line_start].lines() {
             let t = line.trim();
             if let Some(name) = t.strip_prefix("[[").and_then(|r| r.split("]]").next()) {
                 let name = name.trim().to_string();
@@ -198,13 +203,10 @@ impl Source<'_> {
             } else if let Some(name) = t.strip_prefix('[').and_then(|r| r.split(']').next()) {
                 table = name.trim().to_string();
             }
-            line_start += line.len();
         }
-        // The key on the error's own line, when the error is at or after it.
-        let line = self.text[line_start.min(offset)..].lines().next().unwrap_or("");
-        let line = if offset >= line_start { &self.text[line_start..] } else { line };
-        let line = line.lines().next().unwrap_or("");
-        let key = line.split('=').next().filter(|_| line.contains('=')).map(str::trim).filter(|k| {
+        // The key on the error's own line, if the line is `key = value`.
+        let line = self.text[line_start..].lines().next().unwrap_or("");
+        let key = line.split_once('=').map(|(k, _)| k.trim()).filter(|k| {
             !k.is_empty() && k.chars().all(|c| c.is_alphanumeric() || c == '_' || c == '.' || c == '"')
         });
         match (table.is_empty(), key) {
@@ -222,6 +224,7 @@ struct Builder<'a> {
     names: BTreeMap<String, u32>,
     prims: Vec<Prim>,
     lights: Vec<LightSpec>,
+    not_physical: Vec<SceneError>,
 }
 
 /// A value with its span and its place in the file, for checks.
@@ -305,6 +308,19 @@ impl Builder<'_> {
     fn build(mut self, def: FileDef) -> Result<SceneFile, SceneError> {
         for (name, m) in &def.materials {
             let material = self.material(name, m)?;
+            if let Material::Phong(p) = material {
+                if p.albedo_bound() > 1.0 {
+                    self.not_physical.push(self.src.error(
+                        m.get_ref().kind.span(),
+                        format!("materials.{name}"),
+                        format!(
+                            "m_l C + m_s S + m_r C reaches {:.3} > 1: the material reflects more light than it \
+                             receives, which photon mapping cannot render (lower m_l, m_s or m_r)",
+                            p.albedo_bound()
+                        ),
+                    ));
+                }
+            }
             self.materials.push(material);
             self.names.insert(name.clone(), self.materials.len() as u32 - 1);
         }
@@ -319,8 +335,17 @@ impl Builder<'_> {
             Some(a) => self.color(&at(a, "ambient".into()))?,
             None => Color::ZERO,
         };
+        if ambient != Color::ZERO {
+            let span = def.ambient.as_ref().map_or(0..0, |a| a.span());
+            self.not_physical.push(self.src.error(
+                span,
+                "ambient",
+                "ambient light is the Whitted approximation of indirect light; photon mapping computes indirect \
+                 light itself (remove `ambient` or set it to [0, 0, 0])",
+            ));
+        }
         let parts = SceneParts { prims: self.prims, materials: self.materials, lights: self.lights, ambient, camera };
-        Ok(SceneFile { parts, rays_per_pixel_edge })
+        Ok(SceneFile { parts, rays_per_pixel_edge, not_physical: self.not_physical })
     }
 
     fn material(&self, name: &str, m: &Spanned<MaterialDef>) -> Result<Material, SceneError> {
@@ -637,6 +662,17 @@ impl Builder<'_> {
                     Some(v) => self.number(&at(v, format!("lights[{i}].dead_distance")), 0.0, f32::INFINITY, false)?,
                     None => 0.0,
                 };
+                if falloff != 2.0 || dead_distance != 0.0 {
+                    let span = d.falloff.as_ref().or(d.dead_distance.as_ref()).map_or(kind.span.clone(), |v| v.span());
+                    self.not_physical.push(self.src.error(
+                        span,
+                        format!("lights[{i}]"),
+                        format!(
+                            "falloff {falloff} and dead_distance {dead_distance}: light from a point dims as 1/d^2, \
+                             so photon mapping needs falloff = 2 and dead_distance = 0"
+                        ),
+                    ));
+                }
                 LightSpec::Point { position, intensity, falloff, dead_distance }
             }
             "directional" => {
