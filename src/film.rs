@@ -18,6 +18,8 @@ pub enum ToneMap {
     Linear,
     /// sqrt(v) * 255.99 / sqrt(i_max): for scenes with bright spots.
     Sqrt,
+    /// v * 255.99 clamped: 1.0 is white (the Whitted course's colours).
+    Clamp,
 }
 
 impl Film {
@@ -43,8 +45,12 @@ impl Film {
         let curve = |v: f32| match tonemap {
             ToneMap::Linear => v.max(0.0),
             ToneMap::Sqrt => v.max(0.0).sqrt(),
+            ToneMap::Clamp => v.max(0.0),
         };
-        let i_max = self.pixels.iter().fold(0.0f32, |m, c| m.max(c.max_element()));
+        let i_max = match tonemap {
+            ToneMap::Clamp => 1.0,
+            _ => self.pixels.iter().fold(0.0f32, |m, c| m.max(c.max_element())),
+        };
         let scale = if i_max > 0.0 { 255.99 / curve(i_max) * exposure.max(0.0) } else { 0.0 };
         self.pixels.iter().flat_map(|c| c.to_array()).map(|v| (curve(v) * scale).clamp(0.0, 255.0) as u8).collect()
     }

@@ -6,6 +6,7 @@
 //! Both share the camera pass (`render`), direct lighting and the dielectric.
 
 pub mod path;
+pub mod whitted;
 pub mod photon;
 
 use crate::math::{Color, Frame, Ray};

@@ -1,0 +1,146 @@
+//! The Whitted ray tracer of the CS475 assignment (`traceRay`): Phong
+//! shading with the course's formula, a shadow ray per light sample, and
+//! recursive mirror bounces (and glass, split by Fresnel) to a depth limit.
+//!
+//! rho = m_a C A + sum over unshadowed lights of
+//!       (m_l C I max(l . n, 0) + m_s S I max(r . v, 0)^m_sp)
+//!       + m_r C traceRay(reflected ray, depth + 1)
+//!
+//! with `I` the light's colour dimmed by 1 / (d + d0)^falloff (point
+//! lights), undimmed (directional lights), or L cos_l A / d^2 per sample
+//! (area lights, averaged over a fixed stratified set of samples). A
+//! Lambertian material of reflectance rho is read as m_l = 1 / pi, C = rho,
+//! m_a = 1: its direct light is then exactly photonmap's.
+
+use crate::film::Film;
+use crate::material::{Material, Phong};
+use crate::math::{max_component, Color, Frame, Ray};
+use crate::optics::reflect;
+use crate::sampling::{next_2d, stratified_2d, stream, Domain, Rng};
+use crate::scene::{Hit, Scene};
+use crate::shape::Departure;
+use rayon::prelude::*;
+use std::f32::consts::PI;
+
+use super::glass_branches;
+
+/// Shadow-ray samples per area light per shaded point (the course's lights
+/// are points; area lights get a soft shadow from this many samples).
+const AREA_SAMPLES: u32 = 16;
+
+pub struct Whitted<'a> {
+    pub scene: &'a Scene,
+    /// Bounce rays stop after this many reflections (0: none).
+    pub max_depth: u32,
+}
+
+impl Whitted<'_> {
+    /// The colour seen along `ray` (the course's `traceRay`).
+    pub fn trace_ray(&self, ray: &Ray, departure: Option<Departure>, depth: u32, rng: &mut Rng) -> Color {
+        let Some(hit) = self.scene.intersect(ray, departure) else {
+            return Color::ZERO;
+        };
+        let through = self.scene.transmittance(departure, hit.t);
+        let c = match *self.scene.material(hit.prim) {
+            Material::Emitter => self.scene.light_of(hit.prim).map_or(Color::ZERO, |l| l.radiance_towards(ray.dir)),
+            Material::Phong(p) => self.phong(&hit, ray, &p, depth, rng),
+            Material::Lambertian { rho } => {
+                let p = Phong {
+                    color: rho,
+                    ambient: 1.0,
+                    diffuse: 1.0 / PI,
+                    specular: 0.0,
+                    metalness: 0.0,
+                    shininess: 1.0,
+                    mirror: 0.0,
+                };
+                self.phong(&hit, ray, &p, depth, rng)
+            }
+            Material::Mirror { reflectance } => reflectance * self.bounce(&hit, ray, depth, rng),
+            Material::Glass { ior, .. } => {
+                if depth >= self.max_depth {
+                    return Color::ZERO;
+                }
+                let b = glass_branches(&hit, ray, ior);
+                let (r, dep) = hit.spawn(b.reflected);
+                let mut c = b.fresnel * self.trace_ray(&r, Some(dep), depth + 1, rng);
+                if let Some((wt, scale)) = b.refracted {
+                    let (t, dep) = hit.spawn(wt);
+                    c += (1.0 - b.fresnel) * scale * self.trace_ray(&t, Some(dep), depth + 1, rng);
+                }
+                c
+            }
+        };
+        through * c
+    }
+
+    /// The bounce ray: `ray` reflected about the normal, if depth allows.
+    fn bounce(&self, hit: &Hit, ray: &Ray, depth: u32, rng: &mut Rng) -> Color {
+        if depth >= self.max_depth {
+            return Color::ZERO;
+        }
+        let frame = Frame::from_normal(hit.facing_normal(ray.dir));
+        let dir = frame.to_world(reflect(frame.to_local(-ray.dir))).normalize();
+        let (next, dep) = hit.spawn(dir);
+        self.trace_ray(&next, Some(dep), depth + 1, rng)
+    }
+
+    fn phong(&self, hit: &Hit, ray: &Ray, p: &Phong, depth: u32, rng: &mut Rng) -> Color {
+        let n = hit.facing_normal(ray.dir);
+        let v = -ray.dir;
+        let mut c = p.ambient * p.color * self.scene.ambient;
+        let highlight = p.specular * p.highlight();
+        for light in &self.scene.lights {
+            let count = if light.is_delta() { 1 } else { AREA_SAMPLES };
+            let mut sum = Color::ZERO;
+            for s in 0..count {
+                let Some(inc) = light.incident(hit.point, stratified_2d(s, count, next_2d(rng))) else {
+                    continue;
+                };
+                let cos = inc.dir.dot(n);
+                if !(cos > 0.0) {
+                    continue;
+                }
+                // Shadows: a point light only counts blockers before it, a
+                // directional light any blocker along the ray.
+                let (shadow, dep) = hit.spawn(inc.dir);
+                let t_max = inc.target.map_or(f32::INFINITY, |q| (q - shadow.origin).length());
+                if self.scene.occluded(&shadow, Some(dep), t_max, inc.prim) {
+                    continue;
+                }
+                sum += inc.intensity * (p.diffuse * p.color * cos + highlight * p.highlight_factor(n, inc.dir, v));
+            }
+            c += sum / count as f32;
+        }
+        if p.mirror > 0.0 && max_component(p.color) > 0.0 {
+            c += p.mirror * p.color * self.bounce(hit, ray, depth, rng);
+        }
+        c
+    }
+
+    /// Renders the scene's camera at `width` x `height`, each pixel the mean
+    /// of an n x n grid of jittered samples (n = `rays_per_pixel_edge`).
+    /// Every pixel has its own random stream: the image does not depend on
+    /// the number of threads.
+    pub fn render(&self, width: u32, height: u32, rays_per_pixel_edge: u32, seed: u64) -> Film {
+        let camera = self.scene.camera.with_resolution(width, height);
+        let spp = rays_per_pixel_edge * rays_per_pixel_edge;
+        let pixels: Vec<Color> = (0..height)
+            .into_par_iter()
+            .flat_map_iter(|row| {
+                (0..width).map(move |col| {
+                    let pixel = row as u64 * width as u64 + col as u64;
+                    let mut rng = stream(seed, Domain::Camera, pixel);
+                    let mut sum = Color::ZERO;
+                    for s in 0..spp {
+                        let ray = camera.ray(col, row, stratified_2d(s, spp, next_2d(&mut rng)));
+                        sum += self.trace_ray(&ray, None, 0, &mut rng);
+                    }
+                    debug_assert!(sum.is_finite(), "Whitted sample at pixel ({col}, {row}) is {sum}");
+                    sum / spp as f32
+                })
+            })
+            .collect();
+        Film { width, height, pixels }
+    }
+}
