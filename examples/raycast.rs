@@ -1,12 +1,17 @@
 //! Rays per second of the default scene's accelerator, flat loop vs BVH:
-//! `cargo run --release --example raycast`.
+//! `cargo run --release --example raycast`; `-- --mesh`: the 100k-triangle
+//! mesh scene, BVH against the flat loop.
 use photonmap::accel::Accel;
 use photonmap::math::Ray;
 use photonmap::sampling::{next_2d, stream, uniform_cone, Domain};
 use photonmap::scene::{Eye, Scene};
+use photonmap::shape::{Shape, Triangle};
 use std::time::Instant;
 
 fn main() {
+    if std::env::args().any(|a| a == "--mesh") {
+        return mesh_scene();
+    }
     let scene = Scene::tncg15(Eye::One);
     let shapes: Vec<_> = scene.prims.iter().map(|p| p.shape).collect();
     let mut rng = stream(1, Domain::Camera, 0);
@@ -50,5 +55,47 @@ fn main() {
             dt / rays.len() as f64 * 1e9,
             rays.len() as f64 / dt / 1e6
         );
+    }
+}
+
+/// The 100k-triangle scene of notes/performance.md: a glass torus of
+/// 250 x 200 x 2 triangles standing in the default room, camera rays from
+/// eye 1 and random rays, with the BVH and without it (a flat loop).
+fn mesh_scene() {
+    let scene = Scene::tncg15(Eye::One);
+    let mut shapes: Vec<Shape> = scene.prims.iter().map(|p| p.shape).collect();
+    let torus = photonmap::scene::mesh::torus(glam::Vec3::new(8.0, 0.0, -2.0), 2.2, 0.8, 250, 200);
+    shapes.extend(torus.iter().map(|[a, b, c]| Shape::Triangle(Triangle::new(*a, *b, *c))));
+    println!("\nmesh scene: {} primitives (100,000 torus triangles + the room)", shapes.len());
+    let camera = scene.camera.with_resolution(400, 400);
+    let mut rng = stream(2, Domain::Camera, 0);
+    let camera_rays: Vec<Ray> =
+        (0..400 * 400).map(|i| camera.ray(i % 400, i / 400, next_2d(&mut rng))).collect();
+    let random_rays: Vec<Ray> = (0..160_000)
+        .map(|_| {
+            let u = next_2d(&mut rng);
+            let o = glam::Vec3::new(-2.0 + 14.0 * u.x, -5.0 + 10.0 * u.y, -4.5 + 9.0 * next_2d(&mut rng).x);
+            Ray::new(o, uniform_cone(next_2d(&mut rng), -1.0))
+        })
+        .collect();
+    let t = Instant::now();
+    let bvh = Accel::new(shapes.clone());
+    println!("BVH build (binned SAH, serial): {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
+    let flat = Accel::with_flat_limit(shapes, usize::MAX);
+    for (kind, rays) in [("camera", &camera_rays), ("random", &random_rays)] {
+        let mut rates = Vec::new();
+        for (name, accel, n) in [("bvh", &bvh, rays.len()), ("flat", &flat, 2_000)] {
+            let t = Instant::now();
+            let hits = rays[..n].iter().filter(|r| accel.closest_hit(r, None, f32::INFINITY).is_some()).count();
+            let dt = t.elapsed().as_secs_f64();
+            rates.push(n as f64 / dt);
+            println!("{kind} rays, {name}: {:.3} M rays/s/thread ({n} rays, {hits} hits)", n as f64 / dt / 1e6);
+        }
+        println!("{kind} rays: BVH / flat = {:.0}x", rates[0] / rates[1]);
+        // Both find the same nearest hits.
+        for r in &rays[..2_000] {
+            let (a, b) = (bvh.closest_hit(r, None, f32::INFINITY), flat.closest_hit(r, None, f32::INFINITY));
+            assert_eq!(a.map(|h| h.0), b.map(|h| h.0));
+        }
     }
 }

@@ -63,7 +63,7 @@ pub struct ShapeHit {
 
 /// A triangle with vertices `v0, v1, v2`; its normal is `(v1-v0) x (v2-v0)`
 /// normalised. Degenerate (zero-area) triangles are never hit.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Triangle {
     pub v0: Vertex,
     pub v1: Vertex,
@@ -212,7 +212,7 @@ impl Triangle {
 }
 
 /// A sphere; its geometric normal points outwards.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sphere {
     pub center: Vertex,
     pub radius: f32,
@@ -278,7 +278,7 @@ impl Sphere {
 
 /// A flat disk with unit `normal`; one-sided emission is the light's concern,
 /// geometry is hit from both sides.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Disk {
     pub center: Vertex,
     pub normal: Vec3,
@@ -323,7 +323,7 @@ impl Disk {
 /// at the origin onto the shape (an ellipsoid under non-uniform scale). A ray
 /// is carried into object space, met there by the unit sphere, and the hit's
 /// normal is carried back by the inverse transpose.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ellipsoid {
     pub to_world: Affine3A,
     to_object: Affine3A,
@@ -386,7 +386,7 @@ impl Ellipsoid {
 }
 
 /// The geometry of one primitive.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Shape {
     Triangle(Triangle),
     Sphere(Sphere),

@@ -36,3 +36,54 @@ pub fn load_obj(path: &Path) -> Result<Vec<[Vec3; 3]>, String> {
     }
     Ok(triangles)
 }
+
+/// A torus around the z axis through `center` (radii `major` > `minor`),
+/// as 2 x `around` x `tube` triangles wound with outward normals: the
+/// procedural mesh of the BVH benchmarks (250 x 200: 100,000 triangles).
+pub fn torus(center: Vec3, major: f32, minor: f32, around: u32, tube: u32) -> Vec<[Vec3; 3]> {
+    let point = |i: u32, j: u32| {
+        let u = std::f32::consts::TAU * (i % around) as f32 / around as f32;
+        let v = std::f32::consts::TAU * (j % tube) as f32 / tube as f32;
+        let r = major + minor * v.cos();
+        center + Vec3::new(r * u.cos(), r * u.sin(), minor * v.sin())
+    };
+    let mut triangles = Vec::with_capacity(2 * (around * tube) as usize);
+    for i in 0..around {
+        for j in 0..tube {
+            let (a, b, c, d) = (point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1));
+            triangles.push([a, b, c]);
+            triangles.push([a, c, d]);
+        }
+    }
+    triangles
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn torus_is_closed_with_outward_normals() {
+        let c = Vec3::new(1.0, 2.0, 3.0);
+        let tris = torus(c, 2.0, 0.5, 40, 30);
+        assert_eq!(tris.len(), 2400);
+        for [a, b, t] in &tris {
+            let n = (*b - *a).cross(*t - *a);
+            let centroid = (*a + *b + *t) / 3.0;
+            // The tube's centre line point nearest the centroid.
+            let p = centroid - c;
+            let ring = c + Vec3::new(p.x, p.y, 0.0).normalize() * 2.0;
+            assert!(n.dot(centroid - ring) > 0.0, "inward triangle");
+        }
+        // Closed: every edge is shared by exactly two triangles.
+        let key = |p: Vec3| (p * 1e4).round().as_ivec3().to_array();
+        let mut edges = std::collections::HashMap::new();
+        for t in &tris {
+            for k in 0..3 {
+                let (a, b) = (key(t[k]), key(t[(k + 1) % 3]));
+                *edges.entry(if a < b { (a, b) } else { (b, a) }).or_insert(0) += 1;
+            }
+        }
+        assert!(edges.values().all(|&n| n == 2));
+    }
+}
