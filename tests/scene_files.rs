@@ -130,3 +130,112 @@ proptest! {
         }
     }
 }
+
+/// photonmap refuses what it cannot honour (here the Whitted scenes'
+/// ambient light), with the place in the file; `trace` renders the same
+/// file, and its 8-bit output clamps (1.0 is 255).
+#[test]
+fn photonmap_refuses_whitted_only_features_that_trace_renders() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("whitted-only");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = root().join("scenes/whitted-spheres.toml");
+    let out = dir.join("spheres.png");
+    let o = Command::new(env!("CARGO_BIN_EXE_photonmap"))
+        .args(["--scene", scene.to_str().unwrap(), "-q", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && stderr.contains("whitted-spheres.toml:3:11: ambient:"), "{stderr}");
+    assert!(!out.exists());
+    let o = Command::new(env!("CARGO_BIN_EXE_trace")).args([scene.to_str().unwrap(), out.to_str().unwrap(), "2"]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let img = image::open(&out).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (400, 300));
+    // The sky is black, the floor lit, and nothing was normalised to the maximum.
+    assert_eq!(img.get_pixel(200, 2).0, [0, 0, 0]);
+    assert!(img.get_pixel(200, 290).0[0] > 60);
+}
+
+/// Photon mapping and the path tracer agree on scenes lit by an emissive
+/// triangle and by point and directional lights (mean radiance within a few
+/// percent: the two estimators share only the scene).
+#[test]
+fn photon_mapping_agrees_with_path_tracing_for_every_light_type() {
+    let point_and_sun = r#"
+        [camera]
+        eye = [-2, 0, 0]
+        target = [5, 0, -1]
+        up = [0, 0, 1]
+        vfov = 60
+        width = 40
+        height = 40
+        [materials.white]
+        type = "lambertian"
+        rho = [0.7, 0.7, 0.7]
+        [materials.glass]
+        type = "glass"
+        ior = 1.5
+        [[shapes]]
+        type = "room"
+        floor = "white"
+        ceiling = "white"
+        walls = ["white", "white", "white", "white", "white", "white"]
+        [[shapes]]
+        type = "sphere"
+        center = [8, 0, -3.5]
+        radius = 1.5
+        material = "glass"
+        [[lights]]
+        type = "point"
+        position = [8, 0, 3]
+        color = [20, 20, 20]
+    "#;
+    let sun = r#"
+        [camera]
+        eye = [0, -6, 5]
+        target = [0, 0, 0]
+        up = [0, 0, 1]
+        vfov = 50
+        width = 40
+        height = 40
+        [materials.white]
+        type = "lambertian"
+        rho = [0.7, 0.6, 0.5]
+        [materials.glass]
+        type = "glass"
+        ior = 1.5
+        [[shapes]]
+        type = "disk"
+        center = [0, 0, 0]
+        normal = [0, 0, 1]
+        radius = 6
+        material = "white"
+        [[shapes]]
+        type = "sphere"
+        center = [0, 0, 1.5]
+        radius = 1
+        material = "glass"
+        [[lights]]
+        type = "directional"
+        direction = [0.3, 0.2, -1]
+        color = [2, 2, 2]
+    "#;
+    let triangle = std::fs::read_to_string(root().join("scenes/tncg15-triangle-light.toml")).unwrap();
+    for (name, text) in [
+        ("point light", point_and_sun.to_string()),
+        ("directional light", sun.to_string()),
+        ("triangle light", triangle),
+    ] {
+        let mut parts = parse(&text, &root().join("scenes/x.toml")).unwrap().parts;
+        parts.camera = parts.camera.with_resolution(40, 40);
+        let scene = Scene::from_parts(parts);
+        let base = Settings { width: 40, height: 40, ..Settings::default() };
+        let photon = Settings { photons: 200_000, caustic_photons: 200_000, spp: 16, ..base };
+        let path = Settings { method: photonmap::render::Method::Path, spp: 1024, ..base };
+        let (a, sa) = render(&scene, &photon, Mode::Quiet);
+        let (b, _) = render(&scene, &path, Mode::Quiet);
+        assert!(sa.global_stored > 0, "{name}: no photons stored");
+        let (ma, mb) = (a.mean(), b.mean());
+        assert!(mb > 0.0 && (ma - mb).abs() / mb < 0.05, "{name}: photon mean {ma} vs path {mb}");
+    }
+}

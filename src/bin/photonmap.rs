@@ -206,8 +206,12 @@ fn run(cli: Cli) -> Result<(), Error> {
         None => (Scene::tncg15(if cli.eye == Some(2) { Eye::Two } else { Eye::One }), 4),
         Some(path) => {
             let file = photonmap::scene::file::load(path).map_err(|e| Error::Invalid(e.to_string()))?;
-            if let Some(e) = file.not_physical.first() {
-                return Err(Error::Invalid(format!("{e} (the `trace` program renders this scene)")));
+            if !file.not_physical.is_empty() {
+                let all: Vec<String> = file.not_physical.iter().map(|e| e.to_string()).collect();
+                return Err(Error::Invalid(format!(
+                    "{}\n(the `trace` program renders this scene; photonmap cannot honour these)",
+                    all.join("\n")
+                )));
             }
             let n = file.rays_per_pixel_edge;
             (Scene::from_parts(file.parts), n * n)
