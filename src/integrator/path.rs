@@ -43,7 +43,18 @@ impl Integrator for PathIntegrator<'_> {
             ctx.tally.rays += 1;
             let Some(hit) = self.scene.intersect(&ray, departure) else { break };
             throughput *= self.scene.transmittance(departure, hit.t);
-            let wo = match *self.scene.material(hit.prim) {
+            let material = *self.scene.material(hit.prim);
+            let wanted = match part {
+                Part::All => true,
+                Part::Emitted => specular_chain,
+                Part::Reflected => !specular_chain,
+            };
+            if material != Material::Emitter && count_emission && wanted {
+                // A glowing surface's own light; after a diffuse bounce the
+                // shadow rays counted it.
+                radiance += throughput * self.scene.emitted(hit.prim, ray.dir);
+            }
+            let wo = match material {
                 Material::Emitter => {
                     let wanted = match part {
                         Part::All => true,

@@ -134,6 +134,11 @@ impl PhotonIntegrator<'_> {
             Some(p) => self.mirror(hit, ray, p.mirror_rho(), depth, part, ctx),
             None => Color::ZERO,
         };
+        // A glowing surface's own light (zero for all but area lights).
+        let mirrored = match part {
+            Part::Reflected => mirrored,
+            _ => mirrored + self.scene.emitted(hit.prim, ray.dir),
+        };
         let glossy = phong.is_some_and(|p| p.specular > 0.0);
         if part == Part::Emitted || (max_component(rho) <= 0.0 && !glossy) {
             return mirrored;

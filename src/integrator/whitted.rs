@@ -41,7 +41,11 @@ impl Whitted<'_> {
             return Color::ZERO;
         };
         let through = self.scene.transmittance(departure, hit.t);
-        let c = match *self.scene.material(hit.prim) {
+        let glow = match self.scene.material(hit.prim) {
+            Material::Emitter => Color::ZERO,
+            _ => self.scene.emitted(hit.prim, ray.dir),
+        };
+        let c = glow + match *self.scene.material(hit.prim) {
             Material::Emitter => self.scene.light_of(hit.prim).map_or(Color::ZERO, |l| l.radiance_towards(ray.dir)),
             Material::Phong(p) => self.phong(&hit, ray, &p, depth, rng),
             Material::Lambertian { rho } => {

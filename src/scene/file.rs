@@ -496,14 +496,10 @@ impl Builder<'_> {
             present.iter().filter(|(n, _)| !keep.contains(n)).cloned().collect()
         };
         let f = |n: &str| format!("shapes[{i}].{n}");
-        // A triangle or mesh with `emission` is a light, with no material.
+        // A triangle or mesh with `emission` is a light; with a material too
+        // it also reflects (a glowing surface).
         let emission = match &d.emission {
-            Some(e) => {
-                if let Some(m) = &d.material {
-                    return self.fail(m.span(), &f("material"), "an emissive shape has no material (remove one of the two)");
-                }
-                Some(self.color(&at(e, f("emission")))?)
-            }
+            Some(e) => Some(self.color(&at(e, f("emission")))?),
             None => None,
         };
         let vertices = |n: usize| -> Result<Vec<Vec3>, SceneError> {
@@ -610,8 +606,12 @@ impl Builder<'_> {
         }
         match emission {
             Some(radiance) => {
+                let material = match material {
+                    Some(_) => Some(self.material_ref(kind, material)?),
+                    None => None,
+                };
                 for t in kept {
-                    self.lights.push(LightSpec::Area { surface: Emitting::Triangle(t), radiance });
+                    self.lights.push(LightSpec::Area { surface: Emitting::Triangle(t), radiance, material });
                 }
             }
             None => {
@@ -648,7 +648,7 @@ impl Builder<'_> {
                 let normal = self.direction(&self.need(&d.normal, &kind, "normal")?)?;
                 let radius = self.number(&self.need(&d.radius, &kind, "radius")?, 0.0, f32::INFINITY, true)?;
                 let radiance = self.color(&self.need(&d.radiance, &kind, "radiance")?)?;
-                LightSpec::Area { surface: Emitting::Disk(Disk { center, normal, radius }), radiance }
+                LightSpec::Area { surface: Emitting::Disk(Disk { center, normal, radius }), radiance, material: None }
             }
             "point" => {
                 self.reject(&kind, &only(&["position", "color", "falloff", "dead_distance"]))?;

@@ -84,8 +84,10 @@ pub struct Scene {
 /// A light as a scene describes it, before the scene places it.
 #[derive(Clone, Copy, Debug)]
 pub enum LightSpec {
-    /// A one-sided Lambertian emitter; it becomes a primitive of the scene.
-    Area { surface: Emitting, radiance: Color },
+    /// A one-sided Lambertian emitter; it becomes a primitive of the scene,
+    /// of `material` when it also reflects (a glowing wall), else a pure
+    /// emitter that absorbs what reaches it.
+    Area { surface: Emitting, radiance: Color, material: Option<u32> },
     Point { position: Vertex, intensity: Color, falloff: f32, dead_distance: f32 },
     /// Parallel light along unit `direction`.
     Directional { direction: Vec3, irradiance: Color },
@@ -190,17 +192,18 @@ impl Scene {
         let mut light_of_prim = vec![None; prims.len()];
         let mut lights = Vec::new();
         let emitter = materials.len() as u32;
-        if specs.iter().any(|l| matches!(l, LightSpec::Area { .. })) {
+        if specs.iter().any(|l| matches!(l, LightSpec::Area { material: None, .. })) {
             materials.push(Material::Emitter);
         }
         for spec in &specs {
-            if let LightSpec::Area { surface, radiance } = *spec {
+            if let LightSpec::Area { surface, radiance, material } = *spec {
                 let prim = prims.len() as u32;
+                let material = material.unwrap_or(emitter);
                 let shape = match surface {
                     Emitting::Disk(d) => Shape::Disk(d),
                     Emitting::Triangle(t) => Shape::Triangle(t),
                 };
-                prims.push(Prim { shape, material: emitter });
+                prims.push(Prim { shape, material });
                 light_of_prim.push(Some(lights.len() as u32));
                 lights.push(Light::Area(AreaLight::new(surface, radiance, prim)));
             }
@@ -319,7 +322,7 @@ impl Scene {
         SceneParts {
             prims,
             materials,
-            lights: vec![LightSpec::Area { surface: Emitting::Disk(light), radiance: Color::splat(10.0) }],
+            lights: vec![LightSpec::Area { surface: Emitting::Disk(light), radiance: Color::splat(10.0), material: None }],
             ambient: Color::ZERO,
             camera,
         }
@@ -343,6 +346,12 @@ impl Scene {
 
     pub fn material(&self, prim: u32) -> &Material {
         &self.materials[self.prims[prim as usize].material as usize]
+    }
+
+    /// Radiance that primitive `prim` emits itself towards `-dir` (zero
+    /// unless it is the surface of an area light).
+    pub fn emitted(&self, prim: u32, dir: Vec3) -> Color {
+        self.light_of(prim).map_or(Color::ZERO, |l| l.radiance_towards(dir))
     }
 
     /// The area light whose surface primitive `prim` is.
