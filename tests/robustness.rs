@@ -336,3 +336,54 @@ fn degenerate_input_renders_finite_images() {
         render_parts(Scene::tncg15_parts(Eye::One), &s);
     }
 }
+
+/// Rays leaving a surface never skip a surface that is genuinely close: a
+/// second floor 1e-4 above the first (at coordinates around 10), and a
+/// sphere resting on the floor, met from the floor near the contact point
+/// and from the sphere towards the floor.
+#[test]
+fn spawned_rays_do_not_skip_surfaces_that_are_close() {
+    let mut parts = Scene::tncg15_parts(Eye::One);
+    let lambert = parts.materials.len() as u32;
+    parts.materials.push(Material::Lambertian { rho: Color::splat(0.5) });
+    let (a, b, c) = (Vec3::new(5.0, -10.0, 10.0), Vec3::new(15.0, -10.0, 10.0), Vec3::new(10.0, 10.0, 10.0));
+    let up = Vec3::new(0.0, 0.0, 1e-4);
+    let floor = Prim { shape: Shape::Triangle(Triangle::new(a, b, c)), material: lambert };
+    let upper = Prim { shape: Shape::Triangle(Triangle::new(a + up, b + up, c + up)), material: lambert };
+    let ball = Prim { shape: Shape::Sphere(Sphere { center: Vec3::new(10.0, 0.0, 11.0001), radius: 1.0 }), material: lambert };
+    parts.prims = vec![floor, upper, ball];
+    parts.lights.clear();
+    let scene = Scene::from_parts(parts);
+    let mut rng = stream(4, Domain::Camera, 9);
+    for _ in 0..10_000 {
+        let u = next_2d(&mut rng);
+        // A point on the lower floor near the contact, hit from below (the
+        // sphere rests on the upper floor). At distance r from the contact
+        // the sphere is r^2 / 2 above the floor; below r = 0.003 that gap
+        // is under the hit point's rounding bound at these coordinates
+        // (~4e-6) and which surface comes first is undecidable in f32, so
+        // the points keep r >= 0.01 (gap 5e-5, ten times the bound).
+        let r = 0.01 + 0.14 * u.x;
+        let phi = std::f32::consts::TAU * u.y;
+        let p = Vec3::new(10.0 + r * phi.cos(), r * phi.sin(), 9.0);
+        let hit = scene.intersect(&Ray::new(p, Vec3::Z), None).expect("lower floor");
+        assert_eq!(hit.prim, 0);
+        // Leave it upwards in a random direction: the upper floor is next.
+        let d = (photonmap::sampling::uniform_cone(next_2d(&mut rng), 0.05)).normalize();
+        let (ray, dep) = hit.spawn(d);
+        let next = scene.intersect(&ray, Some(dep)).expect("the floor 1e-4 above");
+        assert_eq!(next.prim, 1, "skipped the surface 1e-4 away (t {})", next.t);
+        assert!((next.t * d.z - 1e-4).abs() < 2e-5, "t {}", next.t);
+        // From the upper floor straight up near the contact: the sphere.
+        let top = scene.intersect(&Ray::new(p + Vec3::Z * 0.5, Vec3::Z), Some(photonmap::shape::Departure { prim: 0, outward: true }));
+        let top = top.expect("upper floor");
+        assert_eq!(top.prim, 1);
+        let (ray, dep) = top.spawn(Vec3::Z);
+        let ball_hit = scene.intersect(&ray, Some(dep)).expect("the resting sphere");
+        assert_eq!(ball_hit.prim, 2);
+        // And back down from the sphere: the upper floor, not the lower one.
+        let (ray, dep) = ball_hit.spawn(-Vec3::Z);
+        let down = scene.intersect(&ray, Some(dep)).expect("the floor below the sphere");
+        assert_eq!(down.prim, 1, "ball hit {} n {} / down t {} point {}", ball_hit.point, ball_hit.normal, down.t, down.point);
+    }
+}
