@@ -1,12 +1,17 @@
-//! photonmap: Jensen-style photon mapping for the TNCG15 hexagonal room.
+//! photonmap: Jensen-style photon mapping for the TNCG15 hexagonal room, and
+//! the CS475 Whitted ray tracer (`trace`) over the same core.
 //!
-//! Data flows one way: scene → accelerator → photon maps → integrator →
-//! film → image file.
+//! Data flows one way: scene (built in, or a TOML file: [`scene::file`]) →
+//! accelerator → photon maps → integrator → film → image file; `trace`
+//! skips the photon maps ([`integrator::whitted`]).
 //!
 //! Where the course's classes live (TNCG15 lecture 6):
 //! * `Vertex`, `Direction`, `ColorDbl`: [`math::Vertex`], [`math::Direction`], [`math::Color`];
 //! * `Ray`: [`math::Ray`]; local frames for reflection: [`math::Frame`], [`optics`];
-//! * `Triangle` (Möller–Trumbore), spheres, tetrahedra: [`shape`];
+//! * `Triangle` (Möller–Trumbore), spheres, tetrahedra: [`shape`]; the CS475
+//!   transformed unit sphere: [`shape::Ellipsoid`];
+//! * materials, including CS475's Phong (m_a, m_l, m_s, m_sm, m_sp, m_r): [`material`];
+//! * lights (disk, emissive triangle, point with falloff, directional): [`light`];
 //! * `Scene`: [`scene::Scene`] (the room: [`scene::Scene::tncg15`]);
 //! * `Camera`, `Pixel`: [`camera::Camera`], [`film::Film`], [`render`].
 
