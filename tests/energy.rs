@@ -14,6 +14,11 @@ use photonmap::scene::{tncg15_room, Eye, LightSpec, Scene, SceneParts};
 use photonmap::shape::Shape;
 
 fn furnace(le: f32, rho: f32) -> Scene {
+    furnace_with(le, rho, None)
+}
+
+/// The furnace with an extra sphere of `material` in the middle of the room.
+fn furnace_with(le: f32, rho: f32, sphere: Option<Material>) -> Scene {
     let camera = Scene::tncg15_parts(Eye::Two).camera;
     let lights = tncg15_room(0, 0, [0; 6])
         .into_iter()
@@ -22,9 +27,16 @@ fn furnace(le: f32, rho: f32) -> Scene {
             LightSpec::Area { surface: Emitting::Triangle(t), radiance: Color::splat(le), material: Some(0) }
         })
         .collect();
+    let mut materials = vec![Material::Lambertian { rho: Color::splat(rho) }];
+    let mut prims = Vec::new();
+    if let Some(m) = sphere {
+        materials.push(m);
+        let sphere = photonmap::shape::Sphere { center: glam::Vec3::new(5.0, 0.0, -2.0), radius: 2.0 };
+        prims.push(photonmap::scene::Prim { shape: Shape::Sphere(sphere), material: 1 });
+    }
     Scene::from_parts(SceneParts {
-        prims: Vec::new(),
-        materials: vec![Material::Lambertian { rho: Color::splat(rho) }],
+        prims,
+        materials,
         lights,
         ambient: Color::ZERO,
         camera,
@@ -58,6 +70,29 @@ fn furnace_radiance_is_le_over_one_minus_rho() {
                 (p5 - want).abs() / want < 0.1 && (p95 - want).abs() / want < 0.1,
                 "{name}: 5th/95th percentiles {p5} / {p95}, want {want}"
             );
+        }
+    }
+}
+
+/// A lossless mirror or a clear glass ball in the furnace changes nothing:
+/// whatever it shows is radiance Le / (1 - rho) from somewhere else, so the
+/// whole image stays uniform. This checks that mirrors of reflectance 1 and
+/// glass lose and create no energy through every estimator (caustic map,
+/// camera-path splitting, Fresnel, the (n_i / n_t)^2 radiance scaling).
+#[test]
+fn lossless_mirror_and_glass_keep_the_furnace_uniform() {
+    let (le, rho) = (1.0f32, 0.5f32);
+    let want = le / (1.0 - rho);
+    for material in [Material::Mirror { reflectance: Color::ONE }, Material::glass(1.5)] {
+        let scene = furnace_with(le, rho, Some(material));
+        let base = Settings { width: 16, height: 16, ..Settings::default() };
+        let photon = Settings { photons: 200_000, caustic_photons: 200_000, spp: 4, gather_rays: 16, ..base };
+        let path = Settings { method: Method::Path, spp: 256, ..base };
+        for (name, settings, tolerance) in [("photon", photon, 0.04), ("path", path, 0.02)] {
+            let (film, _) = render(&scene, &settings, Mode::Quiet);
+            let mean = film.mean() as f32;
+            eprintln!("furnace with {material:?}, {name}: mean {mean:.4}, want {want:.4}");
+            assert!((mean - want).abs() / want < tolerance, "{material:?} {name}: mean {mean}, want {want}");
         }
     }
 }
