@@ -92,6 +92,35 @@ fn skips(c: &mut Criterion) {
             g.bench_function(label, |b| b.iter(|| black_box(render(scene, &settings, Mode::Quiet).0.mean())));
         }
     }
+    // Caustic lookups with and without the occupancy grid: a glass ball on
+    // a wide floor under the sun, whose caustic map is empty in most places.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/glass-sun.toml");
+    let glass_only = Scene::from_parts(photonmap::scene::file::load(&path).unwrap().parts);
+    let camera = glass_only.camera.with_resolution(64, 48);
+    let points: Vec<(glam::Vec3, glam::Vec3)> = (0..64 * 48)
+        .filter_map(|i| {
+            let ray = camera.ray(i % 64, i / 64, glam::Vec2::splat(0.5));
+            let hit = glass_only.intersect(&ray, None)?;
+            glass_only.material(hit.prim).diffuse_rho()?;
+            Some((hit.point, hit.facing_normal(ray.dir)))
+        })
+        .collect();
+    let photons = trace_pass(&glass_only, Pass::Caustic, 200_000, 1, &|_| {}).photons;
+    let r = Settings::default().r_caustic(&glass_only);
+    for skip in [true, false] {
+        let map = PhotonMap::build(photons.clone()).with_occupancy(skip.then_some(r));
+        let label = format!("glass_sun_caustic_lookups/{}", if skip { "skip" } else { "no_skip" });
+        g.throughput(Throughput::Elements(points.len() as u64));
+        g.bench_function(label, |b| {
+            let mut scratch = Scratch::default();
+            b.iter(|| {
+                points
+                    .iter()
+                    .map(|&(x, n)| map.radiance_cone(x, n, glam::Vec3::splat(0.8), 100, r, &mut scratch).x)
+                    .sum::<f32>()
+            })
+        });
+    }
     g.finish();
 }
 

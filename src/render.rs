@@ -247,8 +247,10 @@ fn photon_pass(
     stats.photon_rays += global.rays + caustic.rays;
 
     let t = Instant::now();
+    // Caustic lookups may meet empty regions of the map; global-map
+    // lookups run at photons (the irradiance cache) and need no grid.
     let global_map = PhotonMap::build(global.photons);
-    let caustic_map = PhotonMap::build(caustic.photons);
+    let caustic_map = PhotonMap::build(caustic.photons).with_occupancy(settings.skip.then_some(est.r_caustic));
     let cache = IrradianceCache::build(&global_map, settings.cache_stride, est.k_global, est.r_global);
     stats.build_time += t.elapsed();
     stats.global_stored = global_map.len();

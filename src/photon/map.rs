@@ -94,10 +94,82 @@ fn morton_sort(photons: &mut Vec<Photon>) {
     *photons = keys.par_iter().map(|k| photons[(k & 0xFFFF_FFFF) as usize]).collect();
 }
 
-/// A photon map: the photons and a kd-tree over their positions.
+/// A bitmap over the map's bounds of the cells that hold a photon, with
+/// cells as wide as the lookups' radius cap: a lookup whose own cell and
+/// the 26 around it are empty can find nothing, and skips the kd-tree
+/// (whose growing-radius search would descend it several times to learn
+/// that).
+struct Occupancy {
+    lo: Vec3,
+    cell: f32,
+    dims: [i32; 3],
+    bits: Vec<u64>,
+}
+
+/// Cells at most; a larger grid gets wider cells.
+const OCCUPANCY_MAX_CELLS: f32 = 16_777_216.0;
+
+impl Occupancy {
+    fn build(photons: &[Photon], cell: f32) -> Option<Self> {
+        let (lo, hi) = photons.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| {
+            (lo.min(p.position()), hi.max(p.position()))
+        });
+        let extent = hi - lo;
+        if !(cell > 0.0) || !extent.is_finite() || !cell.is_finite() {
+            return None;
+        }
+        let cells = ((extent / cell).floor() + 1.0).element_product();
+        let cell = if cells > OCCUPANCY_MAX_CELLS { cell * (cells / OCCUPANCY_MAX_CELLS).cbrt() * 1.01 } else { cell };
+        let d = (extent / cell).as_ivec3() + 1;
+        let dims = [d.x, d.y, d.z];
+        let mut grid = Occupancy { lo, cell, dims, bits: vec![0; (d.x * d.y * d.z) as usize / 64 + 1] };
+        for p in photons {
+            let i = grid.index(grid.cell_of(p.position()));
+            grid.bits[i / 64] |= 1 << (i % 64);
+        }
+        Some(grid)
+    }
+
+    fn cell_of(&self, x: Vec3) -> [i32; 3] {
+        let c = ((x - self.lo) / self.cell).floor();
+        [c.x as i32, c.y as i32, c.z as i32]
+    }
+
+    fn index(&self, c: [i32; 3]) -> usize {
+        ((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]) as usize
+    }
+
+    fn occupied(&self, c: [i32; 3]) -> bool {
+        if (0..3).any(|a| c[a] < 0 || c[a] >= self.dims[a]) {
+            return false;
+        }
+        let i = self.index(c);
+        self.bits[i / 64] & (1 << (i % 64)) != 0
+    }
+
+    /// Whether a photon may lie within `r` of `x` (false only when none can).
+    fn may_hold(&self, x: Vec3, r: f32) -> bool {
+        if !(r <= self.cell) || !x.is_finite() {
+            return true;
+        }
+        let c = self.cell_of(x);
+        // The query's own cell first: where there are photons, it holds some.
+        if self.occupied(c) {
+            return true;
+        }
+        (-1..=1).any(|dz| {
+            (-1..=1).any(|dy| (-1..=1).any(|dx| self.occupied([c[0] + dx, c[1] + dy, c[2] + dz])))
+        })
+    }
+}
+
+/// A photon map: the photons, a kd-tree over their positions, and a coarse
+/// occupancy grid that answers "nothing here" without the tree.
 pub struct PhotonMap {
     photons: Vec<Photon>,
     tree: PointTree,
+    /// Consulted before the tree, when built ([`PhotonMap::with_occupancy`]).
+    occupancy: Option<Occupancy>,
 }
 
 /// The photons found for one estimate.
@@ -111,7 +183,21 @@ impl PhotonMap {
     pub fn build(mut photons: Vec<Photon>) -> Self {
         morton_sort(&mut photons);
         let tree = PointTree::build(photons.par_iter().map(|p| p.position()));
-        PhotonMap { photons, tree }
+        PhotonMap { photons, tree, occupancy: None }
+    }
+
+    /// The same map with an occupancy grid for lookups with radius caps up
+    /// to `r_cap` (`None`: no grid). Either way every estimate is the same,
+    /// bit for bit: the grid only rejects lookups whose search sphere holds
+    /// no photon.
+    pub fn with_occupancy(mut self, r_cap: Option<f32>) -> Self {
+        self.occupancy = r_cap.and_then(|r| Occupancy::build(&self.photons, r));
+        self
+    }
+
+    /// Whether a lookup at `x` with radius cap `r_max` can skip the tree.
+    pub fn certainly_empty(&self, x: Vec3, r_max: f32) -> bool {
+        self.occupancy.as_ref().is_some_and(|g| !g.may_hold(x, r_max))
     }
 
     pub fn len(&self) -> usize {
@@ -140,6 +226,13 @@ impl PhotonMap {
     /// add no flux: the disk is the surface's own.
     pub fn gather(&self, x: Vec3, n: Vec3, k: usize, r_max: f32, scratch: &mut Scratch) -> Gathered {
         let r_max2 = r_max * r_max;
+        if self.certainly_empty(x, r_max) {
+            // What the search below would conclude after descending the tree
+            // at growing radii: nothing, at the full radius.
+            scratch.buf.clear();
+            scratch.hint_r2 = r_max2;
+            return Gathered { r2: r_max2, count: 0 };
+        }
         let buf = &mut scratch.buf;
         // Search a growing radius from the hint: the result is the same as one
         // search at r_max, at the cost of the photons near the answer only.
