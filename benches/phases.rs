@@ -96,15 +96,7 @@ fn skips(c: &mut Criterion) {
     // a wide floor under the sun, whose caustic map is empty in most places.
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/glass-sun.toml");
     let glass_only = Scene::from_parts(photonmap::scene::file::load(&path).unwrap().parts);
-    let camera = glass_only.camera.with_resolution(64, 48);
-    let points: Vec<(glam::Vec3, glam::Vec3)> = (0..64 * 48)
-        .filter_map(|i| {
-            let ray = camera.ray(i % 64, i / 64, glam::Vec2::splat(0.5));
-            let hit = glass_only.intersect(&ray, None)?;
-            glass_only.material(hit.prim).diffuse_rho()?;
-            Some((hit.point, hit.facing_normal(ray.dir)))
-        })
-        .collect();
+    let points = glass_only.diffuse_hits(64, 48);
     let photons = trace_pass(&glass_only, Pass::Caustic, 200_000, 1, &|_| {}).photons;
     let r = Settings::default().r_caustic(&glass_only);
     for skip in [true, false] {

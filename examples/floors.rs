@@ -6,20 +6,13 @@
 //! `cargo run --release --example floors`
 use photonmap::math::Ray;
 use photonmap::photon::Photon;
-use photonmap::sampling::{next_2d, splitmix64, stream, uniform_cone, Domain};
+use photonmap::sampling::{random_rays, splitmix64};
 use photonmap::scene::{Eye, Scene};
 use std::time::Instant;
 
 fn main() {
     let scene = Scene::tncg15(Eye::One);
-    let mut rng = stream(1, Domain::Camera, 0);
-    let random: Vec<Ray> = (0..1_000_000)
-        .map(|_| {
-            let u = next_2d(&mut rng);
-            let o = glam::Vec3::new(-2.0 + 14.0 * u.x, -5.0 + 10.0 * u.y, -4.5 + 9.0 * next_2d(&mut rng).x);
-            Ray::new(o, uniform_cone(next_2d(&mut rng), -1.0))
-        })
-        .collect();
+    let random = random_rays(glam::Vec3::new(-2.0, -5.0, -4.5), glam::Vec3::new(12.0, 5.0, 4.5), 1_000_000, 1);
     let cam = scene.camera;
     let primary: Vec<Ray> = (0..800 * 800).map(|i| cam.ray(i % 800, i / 800, glam::Vec2::splat(0.5))).collect();
     for (name, rays) in [("random rays in the room", &random), ("primary camera rays", &primary)] {

@@ -3,7 +3,8 @@
 //! mesh scene, BVH against the flat loop.
 use photonmap::accel::Accel;
 use photonmap::math::Ray;
-use photonmap::sampling::{next_2d, stream, uniform_cone, Domain};
+use glam::Vec3;
+use photonmap::sampling::{next_2d, random_rays, stream, Domain};
 use photonmap::scene::{Eye, Scene};
 use photonmap::shape::{Shape, Triangle};
 use std::time::Instant;
@@ -14,14 +15,7 @@ fn main() {
     }
     let scene = Scene::tncg15(Eye::One);
     let shapes: Vec<_> = scene.prims.iter().map(|p| p.shape).collect();
-    let mut rng = stream(1, Domain::Camera, 0);
-    let rays: Vec<Ray> = (0..2_000_000)
-        .map(|_| {
-            let u = next_2d(&mut rng);
-            let o = glam::Vec3::new(-2.0 + 14.0 * u.x, -5.0 + 10.0 * u.y, -4.5 + 9.0 * next_2d(&mut rng).x);
-            Ray::new(o, uniform_cone(next_2d(&mut rng), -1.0))
-        })
-        .collect();
+    let rays = random_rays(Vec3::new(-2.0, -5.0, -4.5), Vec3::new(12.0, 5.0, 4.5), 2_000_000, 1);
     // The course's Möller–Trumbore over the same primitives (spheres and the
     // disk through their own tests), to price the watertight test.
     let t = Instant::now();
@@ -71,18 +65,12 @@ fn mesh_scene() {
     let mut rng = stream(2, Domain::Camera, 0);
     let camera_rays: Vec<Ray> =
         (0..400 * 400).map(|i| camera.ray(i % 400, i / 400, next_2d(&mut rng))).collect();
-    let random_rays: Vec<Ray> = (0..160_000)
-        .map(|_| {
-            let u = next_2d(&mut rng);
-            let o = glam::Vec3::new(-2.0 + 14.0 * u.x, -5.0 + 10.0 * u.y, -4.5 + 9.0 * next_2d(&mut rng).x);
-            Ray::new(o, uniform_cone(next_2d(&mut rng), -1.0))
-        })
-        .collect();
+    let random = random_rays(Vec3::new(-2.0, -5.0, -4.5), Vec3::new(12.0, 5.0, 4.5), 160_000, 3);
     let t = Instant::now();
     let bvh = Accel::new(shapes.clone());
     println!("BVH build (binned SAH, serial): {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
     let flat = Accel::with_flat_limit(shapes, usize::MAX);
-    for (kind, rays) in [("camera", &camera_rays), ("random", &random_rays)] {
+    for (kind, rays) in [("camera", &camera_rays), ("random", &random)] {
         let mut rates = Vec::new();
         for (name, accel, n) in [("bvh", &bvh, rays.len()), ("flat", &flat, 2_000)] {
             let t = Instant::now();

@@ -90,6 +90,20 @@ pub fn uniform_triangle(u: Vec2) -> Vec2 {
     Vec2::new(su * (1.0 - u.y), su * u.y)
 }
 
+/// `n` rays from uniform points in the box [`lo`, `hi`] in uniform
+/// directions, from the camera-domain stream `seed`: the incoherent rays of
+/// the ray-casting benches.
+pub fn random_rays(lo: Vec3, hi: Vec3, n: usize, seed: u64) -> Vec<crate::math::Ray> {
+    let mut rng = stream(seed, Domain::Camera, 0);
+    (0..n)
+        .map(|_| {
+            let (a, b) = (next_2d(&mut rng), next_2d(&mut rng));
+            let o = lo + (hi - lo) * Vec3::new(a.x, a.y, b.x);
+            crate::math::Ray::new(o, uniform_cone(next_2d(&mut rng), -1.0))
+        })
+        .collect()
+}
+
 /// The `index`-th of `n` jittered strata of [0,1)^2 (an `m x m` grid when `n`
 /// is a square; otherwise `n` strata along a line, still jittered).
 pub fn stratified_2d(index: u32, n: u32, u: Vec2) -> Vec2 {

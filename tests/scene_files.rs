@@ -140,6 +140,7 @@ fn photonmap_refuses_whitted_only_features_that_trace_renders() {
     std::fs::create_dir_all(&dir).unwrap();
     let scene = root().join("scenes/whitted-spheres.toml");
     let out = dir.join("spheres.png");
+    let _ = std::fs::remove_file(&out);
     let o = Command::new(env!("CARGO_BIN_EXE_photonmap"))
         .args(["--scene", scene.to_str().unwrap(), "-q", out.to_str().unwrap()])
         .output()

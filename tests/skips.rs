@@ -131,14 +131,6 @@ fn caustic_lookups_where_the_map_is_empty_skip_the_tree() {
 pub fn glass_sun_and_floor_points() -> (Scene, Vec<(glam::Vec3, glam::Vec3)>) {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/glass-sun.toml");
     let scene = Scene::from_parts(photonmap::scene::file::load(&path).unwrap().parts);
-    let camera = scene.camera.with_resolution(64, 48);
-    let points = (0..64 * 48)
-        .filter_map(|i| {
-            let ray = camera.ray(i % 64, i / 64, glam::Vec2::splat(0.5));
-            let hit = scene.intersect(&ray, None)?;
-            scene.material(hit.prim).diffuse_rho()?;
-            Some((hit.point, hit.facing_normal(ray.dir)))
-        })
-        .collect();
+    let points = scene.diffuse_hits(64, 48);
     (scene, points)
 }

@@ -372,6 +372,21 @@ impl Scene {
         }
     }
 
+    /// Where the camera's pixel-centre rays at `width` x `height` first meet
+    /// a diffuse surface: (point, normal towards the camera). The lookups of
+    /// the estimator benches and tests.
+    pub fn diffuse_hits(&self, width: u32, height: u32) -> Vec<(Vertex, Vec3)> {
+        let camera = self.camera.with_resolution(width, height);
+        (0..width * height)
+            .filter_map(|i| {
+                let ray = camera.ray(i % width, i / width, Vec2::splat(0.5));
+                let hit = self.intersect(&ray, None)?;
+                self.material(hit.prim).diffuse_rho()?;
+                Some((hit.point, hit.facing_normal(ray.dir)))
+            })
+            .collect()
+    }
+
     /// Axis-aligned bounds of all primitives.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.bounds
