@@ -113,6 +113,15 @@ impl Settings {
     }
 }
 
+/// Memory the system can give this process (Linux: MemAvailable), if known:
+/// renders that would not fit are refused before they allocate.
+pub fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
 /// What a render did and what it cost.
 #[derive(Clone, Debug, Default)]
 pub struct Stats {

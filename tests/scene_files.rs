@@ -240,3 +240,25 @@ fn photon_mapping_agrees_with_path_tracing_for_every_light_type() {
         assert!(mb > 0.0 && (ma - mb).abs() / mb < 0.05, "{name}: photon mean {ma} vs path {mb}");
     }
 }
+
+/// `trace` refuses an image whose film would not fit in memory, before
+/// allocating it, instead of aborting half-way.
+#[test]
+fn trace_refuses_an_image_that_cannot_fit() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("trace-huge");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(root().join("tests/scenes/bad/zero_width.toml"))
+        .unwrap()
+        .replace("width = 0\nheight = 16", "width = 65536\nheight = 65536");
+    let scene = dir.join("huge.toml");
+    std::fs::write(&scene, text).unwrap();
+    let need = 65536u64 * 65536 * 16;
+    if photonmap::render::available_memory().is_none_or(|a| a >= need) {
+        return; // a machine with 70 GB free would render it
+    }
+    let out = dir.join("huge.png");
+    let o = Command::new(env!("CARGO_BIN_EXE_trace")).args([scene.to_str().unwrap(), out.to_str().unwrap()]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && stderr.contains("65536 x 65536 image needs about"), "{stderr}");
+    assert!(!out.exists());
+}

@@ -8,7 +8,7 @@ use photonmap::film::ToneMap;
 use photonmap::metrics::compare;
 use photonmap::output::{check_writable, read_exr, write};
 use photonmap::progress::Mode;
-use photonmap::render::{render, render_progressive, Budget, Method, Settings, Stats};
+use photonmap::render::{available_memory, render, render_progressive, Budget, Method, Settings, Stats};
 use photonmap::scene::{Eye, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -333,13 +333,6 @@ fn run(cli: Cli) -> Result<(), Error> {
     Ok(())
 }
 
-/// Memory the system can give this process (Linux: MemAvailable), if known.
-fn available_memory() -> Option<u64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
 
 /// Progress of a progressive render: passes done, radii, time left.
 struct PassDisplay {

@@ -7,6 +7,7 @@ use photonmap::error::Error;
 use photonmap::film::ToneMap;
 use photonmap::integrator::whitted::Whitted;
 use photonmap::output::{check_writable, write};
+use photonmap::render::available_memory;
 use photonmap::scene::Scene;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -50,6 +51,15 @@ fn run(cli: Cli) -> Result<(), Error> {
     let n = file.rays_per_pixel_edge;
     let scene = Scene::from_parts(file.parts);
     let (w, h) = (scene.camera.width, scene.camera.height);
+    // The film (12 bytes a pixel) and its 8-bit copy must fit.
+    let need = w as u64 * h as u64 * 16;
+    if available_memory().is_some_and(|available| need > available) {
+        return Err(Error::Invalid(format!(
+            "{}: a {w} x {h} image needs about {:.1} GB; less memory is available",
+            cli.scene.display(),
+            need as f64 / 1e9
+        )));
+    }
     let start = Instant::now();
     let film = Whitted { scene: &scene, max_depth: cli.depth }.render(w, h, n, cli.seed);
     let elapsed = start.elapsed();
