@@ -361,7 +361,7 @@ pub struct PassReport<'a> {
 
 /// Progressive rendering: independent passes, each with its own photons (or,
 /// for path tracing, its own camera samples), averaged. Photon mapping's
-/// estimates narrow from pass to pass ([`Estimates::progressive`]), so the
+/// estimates narrow from pass to pass (`Estimates::progressive`), so the
 /// average converges to the true image. `on_pass` sees the running average
 /// after every pass.
 pub fn render_progressive(
