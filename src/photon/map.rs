@@ -25,6 +25,8 @@ const NORMAL_COSINE: f32 = 0.9;
 #[derive(Default, Debug)]
 pub struct Scratch {
     buf: Vec<(f32, u32)>,
+    /// The terms of an estimate's sum.
+    terms: Vec<Color>,
     hint_r2: f32,
 }
 
@@ -255,9 +257,8 @@ impl PhotonMap {
         scratch.hint_r2 = if r2 < r_max2 { r2 * 1.5 } else { r_max2 };
         buf.retain(|&(_, i)| self.photons[i as usize].surface_normal().dot(n) >= NORMAL_COSINE);
         // The visit order depends on the radius searched, hence on the hint,
-        // hence on which thread ran the previous query: sum in photon order so
-        // the last bits of an estimate do not depend on the thread count.
-        buf.sort_unstable_by_key(|e| e.1);
+        // hence on which thread ran the previous query: the estimates sum
+        // with `order_free_sum`, whose result does not depend on the order.
         Gathered { r2, count: buf.len() }
     }
 
@@ -271,12 +272,14 @@ impl PhotonMap {
             return (Color::ZERO, g.r2);
         }
         let on_rim_excluded = g.r2 < r_max * r_max;
-        let flux: Color = buf
-            .buf
-            .iter()
-            .filter(|&&(d2, _)| !on_rim_excluded || d2 < g.r2)
-            .map(|&(_, i)| self.photons[i as usize].flux())
-            .sum();
+        buf.terms.clear();
+        buf.terms.extend(
+            buf.buf
+                .iter()
+                .filter(|&&(d2, _)| !on_rim_excluded || d2 < g.r2)
+                .map(|&(_, i)| self.photons[i as usize].flux()),
+        );
+        let flux = order_free_sum(&buf.terms);
         (flux / (PI * g.r2), g.r2)
     }
 
@@ -289,10 +292,42 @@ impl PhotonMap {
             return Color::ZERO;
         }
         let r = g.r2.sqrt();
-        let flux: Color =
-            buf.buf.iter().map(|&(d2, i)| self.photons[i as usize].flux() * (1.0 - d2.sqrt() / r).max(0.0)).sum();
+        buf.terms.clear();
+        buf.terms.extend(
+            buf.buf.iter().map(|&(d2, i)| self.photons[i as usize].flux() * (1.0 - d2.sqrt() / r).max(0.0)),
+        );
+        let flux = order_free_sum(&buf.terms);
         rho / PI * flux * 3.0 / (PI * g.r2)
     }
+}
+
+/// The sum of non-negative, finite colours, the same whatever their order
+/// (floating-point addition is not associative; integer addition is): each
+/// term is scaled, per channel, to a 64-bit fixed-point number whose unit is
+/// set by the channel's largest term and the number of terms (neither
+/// depends on order), so the sum cannot overflow, then the terms are added
+/// exactly. The result keeps at least 40 bits relative to the largest term,
+/// more than an f32 holds.
+/// This replaces sorting the photons by index before summing, which cost a
+/// third of a caustic estimate.
+fn order_free_sum(terms: &[Color]) -> Color {
+    let max = terms.iter().fold(Color::ZERO, |m, c| m.max(*c));
+    // Terms below 2^(62 - n_bits) each keep the total below 2^62.
+    let n_bits = (usize::BITS - terms.len().leading_zeros()) as i32;
+    let scale = max.to_array().map(|m| {
+        if m > 0.0 && m.is_finite() {
+            2f64.powi(62 - n_bits - (m.log2().ceil() as i32 + 1))
+        } else {
+            0.0
+        }
+    });
+    let mut sum = [0i64; 3];
+    for c in terms {
+        for ch in 0..3 {
+            sum[ch] += (c[ch] as f64 * scale[ch]) as i64;
+        }
+    }
+    Color::from_array([0, 1, 2].map(|ch| if scale[ch] > 0.0 { (sum[ch] as f64 / scale[ch]) as f32 } else { 0.0 }))
 }
 
 /// Irradiance precomputed at a subset of the global photons (Christensen
@@ -383,6 +418,32 @@ impl IrradianceCache {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The estimates' sum gives the same bits in any order, and agrees with
+    /// an f64 sum to f32 precision, including terms spanning 30 octaves.
+    #[test]
+    fn order_free_sum_ignores_order_and_is_accurate() {
+        let mut rng = crate::sampling::stream(5, crate::sampling::Domain::Camera, 0);
+        for n in [1usize, 7, 100, 5000] {
+            let mut terms: Vec<Color> = (0..n)
+                .map(|_| {
+                    let u = crate::sampling::next_2d(&mut rng);
+                    Color::new(u.x, u.y * 1e-9, (u.x * 30.0).exp2() * 1e-6)
+                })
+                .collect();
+            let a = order_free_sum(&terms);
+            let exact: [f64; 3] =
+                [0, 1, 2].map(|c| terms.iter().map(|t| t.to_array()[c] as f64).sum::<f64>());
+            for (c, want) in exact.iter().enumerate() {
+                let rel = (a[c] as f64 - want).abs() / want;
+                assert!(rel < 1e-6, "n {n} channel {c}: {} vs {want}", a[c]);
+            }
+            terms.reverse();
+            terms.rotate_left(n / 3);
+            assert_eq!(order_free_sum(&terms), a);
+        }
+        assert_eq!(order_free_sum(&[]), Color::ZERO);
+    }
     use crate::sampling::{next_2d, stream, Domain};
 
     /// Photons of equal power spread uniformly over a square: the estimates
