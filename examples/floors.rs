@@ -26,8 +26,7 @@ fn main() {
         println!("occlusion to t = 3, {name}: {:.0} ns per ray ({blocked} blocked)", dt / rays.len() as f64 * 1e9);
     }
     let n = 4_917_159; // global photons stored at 1e6 emitted
-    let mut photons: Vec<(u64, Photon)> =
-        (0..n as u64).map(|i| (splitmix64(i), Photon::default())).collect();
+    let mut photons: Vec<(u64, Photon)> = (0..n as u64).map(|i| (splitmix64(i), Photon::default())).collect();
     let t = Instant::now();
     photons.sort_unstable_by_key(|p| p.0);
     println!("sort of {n} photons (40 bytes with the key) by a 64-bit key: {:.0} ms", t.elapsed().as_secs_f64() * 1e3);

@@ -1,9 +1,9 @@
 //! Rays per second of the default scene's accelerator, flat loop vs BVH:
 //! `cargo run --release --example raycast`; `-- --mesh`: the 100k-triangle
 //! mesh scene, BVH against the flat loop.
+use glam::Vec3;
 use photonmap::accel::Accel;
 use photonmap::math::Ray;
-use glam::Vec3;
 use photonmap::sampling::{next_2d, random_rays, stream, Domain};
 use photonmap::scene::{Eye, Scene};
 use photonmap::shape::{Shape, Triangle};
@@ -63,8 +63,7 @@ fn mesh_scene() {
     println!("\nmesh scene: {} primitives (100,000 torus triangles + the room)", shapes.len());
     let camera = scene.camera.with_resolution(400, 400);
     let mut rng = stream(2, Domain::Camera, 0);
-    let camera_rays: Vec<Ray> =
-        (0..400 * 400).map(|i| camera.ray(i % 400, i / 400, next_2d(&mut rng))).collect();
+    let camera_rays: Vec<Ray> = (0..400 * 400).map(|i| camera.ray(i % 400, i / 400, next_2d(&mut rng))).collect();
     let random = random_rays(Vec3::new(-2.0, -5.0, -4.5), Vec3::new(12.0, 5.0, 4.5), 160_000, 3);
     let t = Instant::now();
     let bvh = Accel::new(shapes.clone());

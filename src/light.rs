@@ -122,11 +122,20 @@ pub enum Light {
     Area(AreaLight),
     /// Emits `intensity` (W/sr) equally in every direction; the Whitted
     /// course dims it as 1 / (d + dead_distance)^falloff (physical: 2, 0).
-    Point { position: Vertex, intensity: Color, falloff: f32, dead_distance: f32 },
+    Point {
+        position: Vertex,
+        intensity: Color,
+        falloff: f32,
+        dead_distance: f32,
+    },
     /// Parallel light travelling along unit `direction`, of irradiance
     /// `irradiance` on a surface facing it. Photons start on a disk facing
     /// the light that covers the scene (`reach`: its centre and radius).
-    Directional { direction: Vec3, irradiance: Color, reach: (Vertex, f32) },
+    Directional {
+        direction: Vec3,
+        irradiance: Color,
+        reach: (Vertex, f32),
+    },
 }
 
 impl Light {
@@ -179,7 +188,12 @@ impl Light {
                 }
                 let scale = (dist + dead_distance).powf(-falloff);
                 let intensity = intensity * scale;
-                intensity.is_finite().then_some(Incident { dir: to / dist, target: Some(position), intensity, prim: None })
+                intensity.is_finite().then_some(Incident {
+                    dir: to / dist,
+                    target: Some(position),
+                    intensity,
+                    prim: None,
+                })
             }
             Light::Directional { direction, irradiance, .. } => {
                 Some(Incident { dir: -direction, target: None, intensity: irradiance, prim: None })

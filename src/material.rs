@@ -91,8 +91,7 @@ impl Phong {
         let lobe = Frame::from_normal(r);
         let dir = lobe.to_world(Vec3::new(sin_a * phi.cos(), sin_a * phi.sin(), cos_a)).normalize();
         let cos_t = dir.dot(n);
-        (cos_t > 0.0)
-            .then(|| (dir, self.specular_rho() * ((self.shininess + 2.0) / (self.shininess + 1.0) * cos_t)))
+        (cos_t > 0.0).then(|| (dir, self.specular_rho() * ((self.shininess + 2.0) / (self.shininess + 1.0) * cos_t)))
     }
 }
 

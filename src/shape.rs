@@ -371,7 +371,8 @@ impl Ellipsoid {
         // The object point's error carried through the matrix, plus the
         // rounding of the matrix product and the translation.
         let p_err = Vec3::from(abs_m * glam::Vec3A::from(unit.p_err + gamma(4) * local.abs()))
-            + gamma(4) * (Vec3::from(abs_m * glam::Vec3A::from(local.abs())) + Vec3::from(self.to_world.translation.abs()));
+            + gamma(4)
+                * (Vec3::from(abs_m * glam::Vec3A::from(local.abs())) + Vec3::from(self.to_world.translation.abs()));
         let normal = (self.to_object.matrix3.transpose() * glam::Vec3A::from(local)).normalize();
         ShapeHit { t, point, p_err, normal: Vec3::from(normal) }
     }

@@ -52,7 +52,8 @@ fn hot_loops_do_not_allocate_per_photon_or_per_ray() {
     }
     // Camera pass: 4x the pixels, and the extra allocations stay at a few
     // per row, far below one per ray.
-    let settings = |size| Settings { photons: 20_000, caustic_photons: 20_000, width: size, height: size, ..Settings::default() };
+    let settings =
+        |size| Settings { photons: 20_000, caustic_photons: 20_000, width: size, height: size, ..Settings::default() };
     let ((_, small), a_small) = count(|| render(&scene, &settings(32), Mode::Quiet));
     let ((_, large), a_large) = count(|| render(&scene, &settings(64), Mode::Quiet));
     let extra_rays = large.camera_rays - small.camera_rays;

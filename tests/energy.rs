@@ -34,13 +34,7 @@ fn furnace_with(le: f32, rho: f32, sphere: Option<Material>) -> Scene {
         let sphere = photonmap::shape::Sphere { center: glam::Vec3::new(5.0, 0.0, -2.0), radius: 2.0 };
         prims.push(photonmap::scene::Prim { shape: Shape::Sphere(sphere), material: 1 });
     }
-    Scene::from_parts(SceneParts {
-        prims,
-        materials,
-        lights,
-        ambient: Color::ZERO,
-        camera,
-    })
+    Scene::from_parts(SceneParts { prims, materials, lights, ambient: Color::ZERO, camera })
 }
 
 /// Renders the furnace `scene` with photon mapping (2e5 photons per map,

@@ -350,7 +350,8 @@ fn spawned_rays_do_not_skip_surfaces_that_are_close() {
     let up = Vec3::new(0.0, 0.0, 1e-4);
     let floor = Prim { shape: Shape::Triangle(Triangle::new(a, b, c)), material: lambert };
     let upper = Prim { shape: Shape::Triangle(Triangle::new(a + up, b + up, c + up)), material: lambert };
-    let ball = Prim { shape: Shape::Sphere(Sphere { center: Vec3::new(10.0, 0.0, 11.0001), radius: 1.0 }), material: lambert };
+    let ball =
+        Prim { shape: Shape::Sphere(Sphere { center: Vec3::new(10.0, 0.0, 11.0001), radius: 1.0 }), material: lambert };
     parts.prims = vec![floor, upper, ball];
     parts.lights.clear();
     let scene = Scene::from_parts(parts);
@@ -375,7 +376,10 @@ fn spawned_rays_do_not_skip_surfaces_that_are_close() {
         assert_eq!(next.prim, 1, "skipped the surface 1e-4 away (t {})", next.t);
         assert!((next.t * d.z - 1e-4).abs() < 2e-5, "t {}", next.t);
         // From the upper floor straight up near the contact: the sphere.
-        let top = scene.intersect(&Ray::new(p + Vec3::Z * 0.5, Vec3::Z), Some(photonmap::shape::Departure { prim: 0, outward: true }));
+        let top = scene.intersect(
+            &Ray::new(p + Vec3::Z * 0.5, Vec3::Z),
+            Some(photonmap::shape::Departure { prim: 0, outward: true }),
+        );
         let top = top.expect("upper floor");
         assert_eq!(top.prim, 1);
         let (ray, dep) = top.spawn(Vec3::Z);
@@ -384,6 +388,10 @@ fn spawned_rays_do_not_skip_surfaces_that_are_close() {
         // And back down from the sphere: the upper floor, not the lower one.
         let (ray, dep) = ball_hit.spawn(-Vec3::Z);
         let down = scene.intersect(&ray, Some(dep)).expect("the floor below the sphere");
-        assert_eq!(down.prim, 1, "ball hit {} n {} / down t {} point {}", ball_hit.point, ball_hit.normal, down.t, down.point);
+        assert_eq!(
+            down.prim, 1,
+            "ball hit {} n {} / down t {} point {}",
+            ball_hit.point, ball_hit.normal, down.t, down.point
+        );
     }
 }

@@ -97,8 +97,7 @@ fn the_default_scene_file_is_the_built_in_room() {
         assert_eq!(from_file.materials[a.material as usize], built_in.materials[b.material as usize]);
     }
     assert_eq!((from_file.camera.width, from_file.camera.height), (800, 800));
-    let settings =
-        Settings { photons: 20_000, caustic_photons: 20_000, width: 48, height: 48, ..Settings::default() };
+    let settings = Settings { photons: 20_000, caustic_photons: 20_000, width: 48, height: 48, ..Settings::default() };
     let (a, _) = render(&from_file, &settings, Mode::Quiet);
     let (b, _) = render(&built_in, &settings, Mode::Quiet);
     assert!(a.pixels == b.pixels, "the file's render differs from the built-in's");
@@ -148,7 +147,10 @@ fn photonmap_refuses_whitted_only_features_that_trace_renders() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && stderr.contains("whitted-spheres.toml:3:11: ambient:"), "{stderr}");
     assert!(!out.exists());
-    let o = Command::new(env!("CARGO_BIN_EXE_trace")).args([scene.to_str().unwrap(), out.to_str().unwrap(), "2"]).output().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_trace"))
+        .args([scene.to_str().unwrap(), out.to_str().unwrap(), "2"])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let img = image::open(&out).unwrap().to_rgb8();
     assert_eq!(img.dimensions(), (400, 300));
@@ -257,7 +259,10 @@ fn trace_refuses_an_image_that_cannot_fit() {
         return; // a machine with 70 GB free would render it
     }
     let out = dir.join("huge.png");
-    let o = Command::new(env!("CARGO_BIN_EXE_trace")).args([scene.to_str().unwrap(), out.to_str().unwrap()]).output().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_trace"))
+        .args([scene.to_str().unwrap(), out.to_str().unwrap()])
+        .output()
+        .unwrap();
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && stderr.contains("65536 x 65536 image needs about"), "{stderr}");
     assert!(!out.exists());

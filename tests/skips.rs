@@ -2,13 +2,13 @@
 //! skip renders the same image with the skip forced off.
 
 use photonmap::film::Film;
+use photonmap::light::Emitting;
 use photonmap::material::Material;
 use photonmap::metrics::compare;
-use photonmap::progress::Mode;
-use photonmap::render::{render, Settings, Stats};
-use photonmap::light::Emitting;
 use photonmap::photon::map::{PhotonMap, Scratch};
 use photonmap::photon::trace::{trace_pass, Pass};
+use photonmap::progress::Mode;
+use photonmap::render::{render, Settings, Stats};
 use photonmap::scene::{Eye, LightSpec, Scene, SceneParts};
 
 fn settings(skip: bool) -> Settings {

@@ -10,7 +10,8 @@ use photonmap::scene::file::parse;
 use photonmap::scene::Scene;
 use std::path::Path;
 
-const CAMERA: &str = "[camera]\neye = [0, 0, 10]\ntarget = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 40\nwidth = 8\nheight = 8\n";
+const CAMERA: &str =
+    "[camera]\neye = [0, 0, 10]\ntarget = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 40\nwidth = 8\nheight = 8\n";
 
 /// A unit sphere at the origin, C = (1, 0.5, 0.25), m_a 0.2, m_l 0.6,
 /// m_s 0.5, m_sm 0, m_sp 10, ambient A = 0.1, and the given lights/extras.
@@ -68,7 +69,9 @@ fn only_the_ambient_term_remains_in_shadow() {
 #[test]
 fn point_light_falloff_at_a_known_distance() {
     // Light 2 units above the top point; the course's 1 / (d + d0)^falloff.
-    for (falloff, dead, scale) in [(1.0f32, 1.0f32, 1.0 / 3.0), (2.0, 0.0, 0.25), (0.0, 0.0, 1.0), (2.0, 2.0, 1.0 / 16.0)] {
+    for (falloff, dead, scale) in
+        [(1.0f32, 1.0f32, 1.0 / 3.0), (2.0, 0.0, 0.25), (0.0, 0.0, 1.0), (2.0, 2.0, 1.0 / 16.0)]
+    {
         let light = format!(
             "[[lights]]\ntype = \"point\"\nposition = [0, 0, 3]\ncolor = [1, 1, 1]\nfalloff = {falloff}\ndead_distance = {dead}\n"
         );

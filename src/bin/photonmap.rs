@@ -333,7 +333,6 @@ fn run(cli: Cli) -> Result<(), Error> {
     Ok(())
 }
 
-
 /// Progress of a progressive render: passes done, radii, time left.
 struct PassDisplay {
     mode: Mode,

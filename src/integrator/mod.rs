@@ -6,8 +6,8 @@
 //! Both share the camera pass (`render`), direct lighting and the dielectric.
 
 pub mod path;
-pub mod whitted;
 pub mod photon;
+pub mod whitted;
 
 use crate::math::{Color, Frame, Ray};
 use crate::optics::{fresnel_dielectric, reflect, refract};

@@ -96,8 +96,15 @@ impl Integrator for PathIntegrator<'_> {
                         mirror()
                     } else {
                         let to_viewer = -ray.dir;
-                        let direct =
-                            direct_light(self.scene, &hit, n, |w| p.brdf(n, w, to_viewer), self.shadow_rays, self.skip, ctx);
+                        let direct = direct_light(
+                            self.scene,
+                            &hit,
+                            n,
+                            |w| p.brdf(n, w, to_viewer),
+                            self.shadow_rays,
+                            self.skip,
+                            ctx,
+                        );
                         radiance += throughput * ctx.checked(direct, "path direct");
                         let Some((lobe, prob)) = p.choose_lobe(ctx.rng.random::<f32>()) else { break };
                         match lobe {

@@ -45,36 +45,37 @@ impl Whitted<'_> {
             Material::Emitter => Color::ZERO,
             _ => self.scene.emitted(hit.prim, ray.dir),
         };
-        let c = glow + match *self.scene.material(hit.prim) {
-            Material::Emitter => self.scene.light_of(hit.prim).map_or(Color::ZERO, |l| l.radiance_towards(ray.dir)),
-            Material::Phong(p) => self.phong(&hit, ray, &p, depth, rng),
-            Material::Lambertian { rho } => {
-                let p = Phong {
-                    color: rho,
-                    ambient: 1.0,
-                    diffuse: 1.0 / PI,
-                    specular: 0.0,
-                    metalness: 0.0,
-                    shininess: 1.0,
-                    mirror: 0.0,
-                };
-                self.phong(&hit, ray, &p, depth, rng)
-            }
-            Material::Mirror { reflectance } => reflectance * self.bounce(&hit, ray, depth, rng),
-            Material::Glass { ior, .. } => {
-                if depth >= self.max_depth {
-                    return Color::ZERO;
+        let c = glow
+            + match *self.scene.material(hit.prim) {
+                Material::Emitter => self.scene.light_of(hit.prim).map_or(Color::ZERO, |l| l.radiance_towards(ray.dir)),
+                Material::Phong(p) => self.phong(&hit, ray, &p, depth, rng),
+                Material::Lambertian { rho } => {
+                    let p = Phong {
+                        color: rho,
+                        ambient: 1.0,
+                        diffuse: 1.0 / PI,
+                        specular: 0.0,
+                        metalness: 0.0,
+                        shininess: 1.0,
+                        mirror: 0.0,
+                    };
+                    self.phong(&hit, ray, &p, depth, rng)
                 }
-                let b = glass_branches(&hit, ray, ior);
-                let (r, dep) = hit.spawn(b.reflected);
-                let mut c = b.fresnel * self.trace_ray(&r, Some(dep), depth + 1, rng);
-                if let Some((wt, scale)) = b.refracted {
-                    let (t, dep) = hit.spawn(wt);
-                    c += (1.0 - b.fresnel) * scale * self.trace_ray(&t, Some(dep), depth + 1, rng);
+                Material::Mirror { reflectance } => reflectance * self.bounce(&hit, ray, depth, rng),
+                Material::Glass { ior, .. } => {
+                    if depth >= self.max_depth {
+                        return Color::ZERO;
+                    }
+                    let b = glass_branches(&hit, ray, ior);
+                    let (r, dep) = hit.spawn(b.reflected);
+                    let mut c = b.fresnel * self.trace_ray(&r, Some(dep), depth + 1, rng);
+                    if let Some((wt, scale)) = b.refracted {
+                        let (t, dep) = hit.spawn(wt);
+                        c += (1.0 - b.fresnel) * scale * self.trace_ray(&t, Some(dep), depth + 1, rng);
+                    }
+                    c
                 }
-                c
-            }
-        };
+            };
         through * c
     }
 

@@ -159,9 +159,7 @@ impl Occupancy {
         if self.occupied(c) {
             return true;
         }
-        (-1..=1).any(|dz| {
-            (-1..=1).any(|dy| (-1..=1).any(|dx| self.occupied([c[0] + dx, c[1] + dy, c[2] + dz])))
-        })
+        (-1..=1).any(|dz| (-1..=1).any(|dy| (-1..=1).any(|dx| self.occupied([c[0] + dx, c[1] + dy, c[2] + dz]))))
     }
 }
 
@@ -293,9 +291,8 @@ impl PhotonMap {
         }
         let r = g.r2.sqrt();
         buf.terms.clear();
-        buf.terms.extend(
-            buf.buf.iter().map(|&(d2, i)| self.photons[i as usize].flux() * (1.0 - d2.sqrt() / r).max(0.0)),
-        );
+        buf.terms
+            .extend(buf.buf.iter().map(|&(d2, i)| self.photons[i as usize].flux() * (1.0 - d2.sqrt() / r).max(0.0)));
         let flux = order_free_sum(&buf.terms);
         rho / PI * flux * 3.0 / (PI * g.r2)
     }
@@ -432,8 +429,7 @@ mod tests {
                 })
                 .collect();
             let a = order_free_sum(&terms);
-            let exact: [f64; 3] =
-                [0, 1, 2].map(|c| terms.iter().map(|t| t.to_array()[c] as f64).sum::<f64>());
+            let exact: [f64; 3] = [0, 1, 2].map(|c| terms.iter().map(|t| t.to_array()[c] as f64).sum::<f64>());
             for (c, want) in exact.iter().enumerate() {
                 let rel = (a[c] as f64 - want).abs() / want;
                 assert!(rel < 1e-6, "n {n} channel {c}: {} vs {want}", a[c]);

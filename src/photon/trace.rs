@@ -7,17 +7,19 @@
 //! number of threads.
 
 use super::Photon;
+use crate::light::Light;
 use crate::material::{Lobe, Material};
 use crate::math::{max_component, Color, Frame, Ray};
 use crate::optics::{fresnel_dielectric, reflect, refract};
-use crate::light::Light;
-use crate::sampling::{concentric_disk, cosine_hemisphere, next_2d, stream, uniform_cone, uniform_cone_pdf, Domain, Rng};
-use std::f32::consts::PI;
+use crate::sampling::{
+    concentric_disk, cosine_hemisphere, next_2d, stream, uniform_cone, uniform_cone_pdf, Domain, Rng,
+};
 use crate::scene::Scene;
 use crate::shape::Departure;
 use glam::Vec3;
 use rand::RngExt;
 use rayon::prelude::*;
+use std::f32::consts::PI;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Photons are traced in blocks of this many; each block is one rayon task.

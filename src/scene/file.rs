@@ -161,8 +161,15 @@ pub fn load(path: &Path) -> Result<SceneFile, SceneError> {
 pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
     let src = Source { path, text };
     let def: FileDef = toml::from_str(text).map_err(|e| src.toml_error(&e))?;
-    Builder { src, materials: Vec::new(), names: BTreeMap::new(), prims: Vec::new(), lights: Vec::new(), not_physical: Vec::new() }
-        .build(def)
+    Builder {
+        src,
+        materials: Vec::new(),
+        names: BTreeMap::new(),
+        prims: Vec::new(),
+        lights: Vec::new(),
+        not_physical: Vec::new(),
+    }
+    .build(def)
 }
 
 /// The text being read, for turning spans into lines and columns.
@@ -206,9 +213,10 @@ impl Source<'_> {
         }
         // The key on the error's own line, if the line is `key = value`.
         let line = self.text[line_start..].lines().next().unwrap_or("");
-        let key = line.split_once('=').map(|(k, _)| k.trim()).filter(|k| {
-            !k.is_empty() && k.chars().all(|c| c.is_alphanumeric() || c == '_' || c == '.' || c == '"')
-        });
+        let key = line
+            .split_once('=')
+            .map(|(k, _)| k.trim())
+            .filter(|k| !k.is_empty() && k.chars().all(|c| c.is_alphanumeric() || c == '_' || c == '.' || c == '"'));
         match (table.is_empty(), key) {
             (true, Some(k)) => k.to_string(),
             (false, Some(k)) => format!("{table}.{k}"),
@@ -507,7 +515,10 @@ impl Builder<'_> {
             if v.value.len() != n {
                 return self.fail(v.span, &v.field, format!("needs {n} vertices, got {}", v.value.len()));
             }
-            v.value.iter().map(|p| self.finite(&At { value: p, span: v.span.clone(), field: v.field.clone() })).collect()
+            v.value
+                .iter()
+                .map(|p| self.finite(&At { value: p, span: v.span.clone(), field: v.field.clone() }))
+                .collect()
         };
         match kind.value.as_str() {
             "triangle" => {
@@ -524,15 +535,17 @@ impl Builder<'_> {
                 let triangles = load_obj(&obj_path)
                     .map_err(|e| self.src.error(file.span.clone(), file.field.clone(), e))?
                     .into_iter()
-                    .map(|[a, b, c]| {
-                        Triangle::new(m.transform_point3(a), m.transform_point3(b), m.transform_point3(c))
-                    })
+                    .map(|[a, b, c]| Triangle::new(m.transform_point3(a), m.transform_point3(b), m.transform_point3(c)))
                     .collect::<Vec<_>>();
                 self.triangles(&kind, &d.material, emission, &triangles, &d.vertices)?;
             }
             "sphere" | "ellipsoid" | "tetrahedron" | "disk" | "room" if emission.is_some() => {
                 let e = d.emission.as_ref().map(|e| e.span()).unwrap_or(kind.span.clone());
-                return self.fail(e, &f("emission"), "only triangles and meshes can be made emissive (or use a disk light)");
+                return self.fail(
+                    e,
+                    &f("emission"),
+                    "only triangles and meshes can be made emissive (or use a disk light)",
+                );
             }
             "sphere" => {
                 self.reject(&kind, &only(&["material", "center", "radius"]))?;
@@ -545,7 +558,8 @@ impl Builder<'_> {
                 self.reject(&kind, &only(&["material", "transform"]))?;
                 let material = self.material_ref(&kind, &d.material)?;
                 let m = self.transform(i, &d.transform)?;
-                let e = Ellipsoid::new(m).ok_or_else(|| self.src.error(kind.span.clone(), f("transform"), "the transform is singular"))?;
+                let e = Ellipsoid::new(m)
+                    .ok_or_else(|| self.src.error(kind.span.clone(), f("transform"), "the transform is singular"))?;
                 self.prims.push(Prim { shape: Shape::Ellipsoid(e), material });
             }
             "tetrahedron" => {
@@ -570,7 +584,11 @@ impl Builder<'_> {
                 let ceiling = self.material_ref(&kind, &d.ceiling)?;
                 let walls_def = self.need(&d.walls, &kind, "walls")?;
                 if walls_def.value.len() != 6 {
-                    return self.fail(walls_def.span, &walls_def.field, format!("needs 6 wall materials, got {}", walls_def.value.len()));
+                    return self.fail(
+                        walls_def.span,
+                        &walls_def.field,
+                        format!("needs 6 wall materials, got {}", walls_def.value.len()),
+                    );
                 }
                 let mut walls = [0u32; 6];
                 for (w, name) in walls.iter_mut().zip(walls_def.value.iter()) {
@@ -582,7 +600,9 @@ impl Builder<'_> {
                 return self.fail(
                     kind.span.clone(),
                     &kind.field,
-                    format!("unknown shape type \"{other}\" (triangle, mesh, sphere, ellipsoid, tetrahedron, disk, room)"),
+                    format!(
+                        "unknown shape type \"{other}\" (triangle, mesh, sphere, ellipsoid, tetrahedron, disk, room)"
+                    ),
                 )
             }
         }
@@ -599,7 +619,8 @@ impl Builder<'_> {
         triangles: &[Triangle],
         vertices: &Option<Spanned<Vec<V3>>>,
     ) -> Result<(), SceneError> {
-        let kept: Vec<Triangle> = triangles.iter().copied().filter(|t| t.area() > 0.0 && t.normal.is_finite()).collect();
+        let kept: Vec<Triangle> =
+            triangles.iter().copied().filter(|t| t.area() > 0.0 && t.normal.is_finite()).collect();
         if kept.is_empty() {
             let span = vertices.as_ref().map_or(kind.span.clone(), |v| v.span());
             return self.fail(span, &kind.field.replace(".type", ""), "has no triangle of non-zero area");
@@ -725,7 +746,11 @@ impl Builder<'_> {
             let mut p = [Vec3::ZERO; 4];
             for ((slot, c), name) in p.iter_mut().zip(corners).zip(names) {
                 let Some(c) = c else {
-                    return self.fail(c_span(c, &d.eye), &f(name), format!("missing field `{name}` (all four corners are needed)"));
+                    return self.fail(
+                        c_span(c, &d.eye),
+                        &f(name),
+                        format!("missing field `{name}` (all four corners are needed)"),
+                    );
                 };
                 *slot = self.finite(&at(c, f(name)))?;
             }
@@ -733,8 +758,13 @@ impl Builder<'_> {
             // The corners must form a parallelogram the eye is not on.
             let err = ((lr - ll) - (ur - ul)).length();
             let size = (lr - ll).length().max((ul - ll).length());
-            if !(size > 0.0) || err > 1e-4 * size || (ul - ll).cross(lr - ll).dot(ll - eye).abs() <= 1e-12 * size * size {
-                return self.fail(c.span(), "camera", "the corners must form a rectangle in a plane not through the eye");
+            if !(size > 0.0) || err > 1e-4 * size || (ul - ll).cross(lr - ll).dot(ll - eye).abs() <= 1e-12 * size * size
+            {
+                return self.fail(
+                    c.span(),
+                    "camera",
+                    "the corners must form a rectangle in a plane not through the eye",
+                );
             }
             Camera::from_corners(eye, [lr, ll, ul, ur], width, height)
         } else {
@@ -742,10 +772,18 @@ impl Builder<'_> {
             let up = self.direction(&self.need_cam(&d.up, c, "up")?)?;
             let vfov = self.number(&self.need_cam(&d.vfov, c, "vfov")?, 0.0, 179.0, true)?;
             let forward = (target - eye).try_normalize().ok_or_else(|| {
-                self.src.error(d.target.as_ref().map_or(c.span(), |t| t.span()), f("target"), "must differ from the eye")
+                self.src.error(
+                    d.target.as_ref().map_or(c.span(), |t| t.span()),
+                    f("target"),
+                    "must differ from the eye",
+                )
             })?;
             let right = forward.cross(up).try_normalize().ok_or_else(|| {
-                self.src.error(d.up.as_ref().map_or(c.span(), |t| t.span()), f("up"), "must not be parallel to the view direction")
+                self.src.error(
+                    d.up.as_ref().map_or(c.span(), |t| t.span()),
+                    f("up"),
+                    "must not be parallel to the view direction",
+                )
             })?;
             let true_up = right.cross(forward);
             let h = (vfov.to_radians() * 0.5).tan();
@@ -760,7 +798,12 @@ impl Builder<'_> {
         Ok((camera, n))
     }
 
-    fn need_cam<'v, T>(&self, v: &'v Option<Spanned<T>>, c: &Spanned<CameraDef>, name: &str) -> Result<At<'v, T>, SceneError> {
+    fn need_cam<'v, T>(
+        &self,
+        v: &'v Option<Spanned<T>>,
+        c: &Spanned<CameraDef>,
+        name: &str,
+    ) -> Result<At<'v, T>, SceneError> {
         match v {
             Some(s) => Ok(at(s, format!("camera.{name}"))),
             None => self.fail(

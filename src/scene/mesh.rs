@@ -19,7 +19,13 @@ pub fn load_obj(path: &Path) -> Result<Vec<[Vec3; 3]>, String> {
         let vertex = |i: u32| -> Result<Vec3, String> {
             let i = i as usize;
             if 3 * i + 2 >= positions.len() {
-                return Err(format!("OBJ file {}: model '{}' refers to vertex {} of {}", path.display(), m.name, i + 1, positions.len() / 3));
+                return Err(format!(
+                    "OBJ file {}: model '{}' refers to vertex {} of {}",
+                    path.display(),
+                    m.name,
+                    i + 1,
+                    positions.len() / 3
+                ));
             }
             let v = Vec3::new(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
             if !v.is_finite() {

@@ -87,10 +87,22 @@ pub enum LightSpec {
     /// A one-sided Lambertian emitter; it becomes a primitive of the scene,
     /// of `material` when it also reflects (a glowing wall), else a pure
     /// emitter that absorbs what reaches it.
-    Area { surface: Emitting, radiance: Color, material: Option<u32> },
-    Point { position: Vertex, intensity: Color, falloff: f32, dead_distance: f32 },
+    Area {
+        surface: Emitting,
+        radiance: Color,
+        material: Option<u32>,
+    },
+    Point {
+        position: Vertex,
+        intensity: Color,
+        falloff: f32,
+        dead_distance: f32,
+    },
     /// Parallel light along unit `direction`.
-    Directional { direction: Vec3, irradiance: Color },
+    Directional {
+        direction: Vec3,
+        irradiance: Color,
+    },
 }
 
 /// A scene's ingredients, before [`Scene::from_parts`] derives what the
@@ -322,7 +334,11 @@ impl Scene {
         SceneParts {
             prims,
             materials,
-            lights: vec![LightSpec::Area { surface: Emitting::Disk(light), radiance: Color::splat(10.0), material: None }],
+            lights: vec![LightSpec::Area {
+                surface: Emitting::Disk(light),
+                radiance: Color::splat(10.0),
+                material: None,
+            }],
             ambient: Color::ZERO,
             camera,
         }
