@@ -11,7 +11,6 @@
 use super::{direct_light, glass_branches, Context, Integrator, Part};
 use crate::material::{Lobe, Material};
 use crate::math::{max_component, Color, Frame, Ray};
-use crate::optics::reflect;
 use crate::sampling::{cosine_hemisphere, next_2d};
 use crate::scene::Scene;
 use rand::RngExt;
@@ -83,17 +82,13 @@ impl Integrator for PathIntegrator<'_> {
                 }
                 Material::Phong(p) => {
                     let n = hit.facing_normal(ray.dir);
-                    let mirror = || {
-                        let f = Frame::from_normal(n);
-                        f.to_world(reflect(f.to_local(-ray.dir)))
-                    };
                     if part == Part::Emitted {
                         // Only the mirror lobe continues a specular chain.
                         if p.mirror <= 0.0 {
                             break;
                         }
                         throughput *= p.mirror_rho();
-                        mirror()
+                        hit.mirrored(ray.dir)
                     } else {
                         let to_viewer = -ray.dir;
                         let direct = direct_light(
@@ -111,7 +106,7 @@ impl Integrator for PathIntegrator<'_> {
                             Lobe::Mirror => {
                                 count_emission = true;
                                 throughput *= p.mirror_rho() / prob;
-                                mirror()
+                                hit.mirrored(ray.dir)
                             }
                             Lobe::Diffuse => {
                                 count_emission = false;
@@ -132,8 +127,7 @@ impl Integrator for PathIntegrator<'_> {
                 Material::Mirror { reflectance } => {
                     throughput *= reflectance;
                     count_emission = true;
-                    let f = Frame::from_normal(hit.facing_normal(ray.dir));
-                    f.to_world(reflect(f.to_local(-ray.dir)))
+                    hit.mirrored(ray.dir)
                 }
                 Material::Glass { ior, .. } => {
                     count_emission = true;

@@ -19,7 +19,6 @@
 use super::{direct_light, glass_branches, Context, Integrator, Part};
 use crate::material::{Material, Phong};
 use crate::math::{max_component, Color, Frame, Ray};
-use crate::optics::reflect;
 use crate::photon::map::{IrradianceCache, PhotonMap};
 use crate::sampling::{cosine_hemisphere, next_2d, stratified_2d};
 use crate::scene::{Hit, Scene};
@@ -111,9 +110,7 @@ impl PhotonIntegrator<'_> {
         if depth >= MAX_SPECULAR_DEPTH || max_component(reflectance) <= 0.0 {
             return Color::ZERO;
         }
-        let frame = Frame::from_normal(hit.facing_normal(ray.dir));
-        let wo = frame.to_world(reflect(frame.to_local(-ray.dir))).normalize();
-        let (next, dep) = hit.spawn(wo);
+        let (next, dep) = hit.spawn(hit.mirrored(ray.dir));
         reflectance * self.trace(next, Some(dep), depth + 1, part, ctx)
     }
 
@@ -215,13 +212,11 @@ impl PhotonIntegrator<'_> {
             let next_dir = match material {
                 Material::Mirror { reflectance } => {
                     weight *= reflectance;
-                    let f = Frame::from_normal(y.facing_normal(ray.dir));
-                    f.to_world(reflect(f.to_local(-ray.dir)))
+                    y.mirrored(ray.dir)
                 }
                 Material::Phong(p) if p.mirror > 0.0 => {
                     weight *= p.mirror_rho();
-                    let f = Frame::from_normal(y.facing_normal(ray.dir));
-                    f.to_world(reflect(f.to_local(-ray.dir)))
+                    y.mirrored(ray.dir)
                 }
                 Material::Glass { ior, .. } => {
                     let b = glass_branches(&y, &ray, ior);

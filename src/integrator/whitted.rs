@@ -14,8 +14,7 @@
 
 use crate::film::Film;
 use crate::material::{Material, Phong};
-use crate::math::{max_component, Color, Frame, Ray};
-use crate::optics::reflect;
+use crate::math::{max_component, Color, Ray};
 use crate::sampling::{next_2d, stratified_2d, stream, Domain, Rng};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;
@@ -84,9 +83,7 @@ impl Whitted<'_> {
         if depth >= self.max_depth {
             return Color::ZERO;
         }
-        let frame = Frame::from_normal(hit.facing_normal(ray.dir));
-        let dir = frame.to_world(reflect(frame.to_local(-ray.dir))).normalize();
-        let (next, dep) = hit.spawn(dir);
+        let (next, dep) = hit.spawn(hit.mirrored(ray.dir));
         self.trace_ray(&next, Some(dep), depth + 1, rng)
     }
 

@@ -486,19 +486,18 @@ impl Builder<'_> {
     fn shape(&mut self, i: usize, s: &Spanned<ShapeDef>) -> Result<(), SceneError> {
         let d = s.get_ref();
         let kind = at(&d.kind, format!("shapes[{i}].type"));
-        let sp = |o: Option<Range<usize>>| o;
         let present = [
-            ("material", sp(d.material.as_ref().map(|x| x.span()))),
-            ("emission", sp(d.emission.as_ref().map(|x| x.span()))),
-            ("vertices", sp(d.vertices.as_ref().map(|x| x.span()))),
-            ("center", sp(d.center.as_ref().map(|x| x.span()))),
-            ("radius", sp(d.radius.as_ref().map(|x| x.span()))),
-            ("normal", sp(d.normal.as_ref().map(|x| x.span()))),
-            ("file", sp(d.file.as_ref().map(|x| x.span()))),
-            ("transform", sp(d.transform.as_ref().and_then(|x| x.first()).map(|x| x.span()))),
-            ("floor", sp(d.floor.as_ref().map(|x| x.span()))),
-            ("ceiling", sp(d.ceiling.as_ref().map(|x| x.span()))),
-            ("walls", sp(d.walls.as_ref().map(|x| x.span()))),
+            ("material", d.material.as_ref().map(|x| x.span())),
+            ("emission", d.emission.as_ref().map(|x| x.span())),
+            ("vertices", d.vertices.as_ref().map(|x| x.span())),
+            ("center", d.center.as_ref().map(|x| x.span())),
+            ("radius", d.radius.as_ref().map(|x| x.span())),
+            ("normal", d.normal.as_ref().map(|x| x.span())),
+            ("file", d.file.as_ref().map(|x| x.span())),
+            ("transform", d.transform.as_ref().and_then(|x| x.first()).map(|x| x.span())),
+            ("floor", d.floor.as_ref().map(|x| x.span())),
+            ("ceiling", d.ceiling.as_ref().map(|x| x.span())),
+            ("walls", d.walls.as_ref().map(|x| x.span())),
         ];
         let only = |keep: &[&str]| -> Vec<(&str, Option<Range<usize>>)> {
             present.iter().filter(|(n, _)| !keep.contains(n)).cloned().collect()

@@ -42,6 +42,13 @@ impl Hit {
         }
     }
 
+    /// The unit direction in which a perfect mirror at this hit sends a ray
+    /// that arrived travelling along `dir`.
+    pub fn mirrored(&self, dir: Vec3) -> Vec3 {
+        let frame = crate::math::Frame::from_normal(self.facing_normal(dir));
+        frame.to_world(crate::optics::reflect(frame.to_local(-dir))).normalize()
+    }
+
     /// A ray leaving this hit along unit `dir`, with its departure record.
     pub fn spawn(&self, dir: Vec3) -> (Ray, Departure) {
         let origin = offset_ray_origin(self.point, self.p_err, self.normal, dir);
