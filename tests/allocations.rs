@@ -1,7 +1,9 @@
 //! Hot loops allocate nothing: a counting global allocator shows that the
 //! photon pass allocates per block of photons (not per photon) and the
 //! camera pass per row of pixels (not per ray). One test, so that no other
-//! test's allocations run in between.
+//! test's allocations run in between, and on a one-thread pool: with more
+//! threads, how often rayon splits the work (and so how many per-split
+//! buffers exist) depends on stealing, and the counts would be noise.
 
 use photonmap::photon::trace::{trace_pass, Pass};
 use photonmap::progress::Mode;
@@ -39,6 +41,11 @@ fn count<T>(f: impl FnOnce() -> T) -> (T, u64) {
 
 #[test]
 fn hot_loops_do_not_allocate_per_photon_or_per_ray() {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    pool.install(check_counts);
+}
+
+fn check_counts() {
     let scene = Scene::tncg15(Eye::One);
     // Photon pass: 4x the photons, and the extra allocations stay at a few
     // per 4096-photon block (the block's photon buffer growing).
@@ -61,5 +68,5 @@ fn hot_loops_do_not_allocate_per_photon_or_per_ray() {
     eprintln!("camera pass: {a_small} / {a_large} allocations for {} / {} rays", small.camera_rays, large.camera_rays);
     assert!(per_ray < 1e-2, "camera pass: {per_ray:.5} allocations per ray");
     let per_row = (a_large - a_small) as f64 / 32.0;
-    assert!(per_row < 8.0, "camera pass: {per_row:.1} allocations per extra row of pixels");
+    assert!(per_row < 3.0, "camera pass: {per_row:.1} allocations per extra row of pixels");
 }
