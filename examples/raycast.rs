@@ -49,6 +49,8 @@ fn main() {
             dt / rays.len() as f64 * 1e9,
             rays.len() as f64 / dt / 1e6
         );
+        let tests: u64 = rays.iter().map(|r| accel.count_tests(r)).sum();
+        println!("  {:.1} primitives tested per ray", tests as f64 / rays.len() as f64);
     }
 }
 

@@ -103,6 +103,10 @@ struct Cli {
     /// Shadow rays per light per diffuse camera hit.
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     shadow_rays: u32,
+    /// Irradiance is precomputed at every N-th stored global photon, and
+    /// final-gather rays read the nearest precomputed value.
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    cache_stride: u32,
     /// Samples of the light seen in pixels on the rim of a light's image
     /// (directly or in mirrors and glass; 0: no extra samples).
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(0..=1_000_000))]
@@ -235,6 +239,7 @@ fn run(cli: Cli) -> Result<(), Error> {
         gather_rays: cli.gather_rays,
         shadow_rays: cli.shadow_rays,
         edge_spp: cli.edge_spp,
+        cache_stride: cli.cache_stride as usize,
         skip: !cli.no_skip,
         ..Settings::default()
     };
