@@ -76,7 +76,7 @@ impl Default for Settings {
             r_caustic: None,
             gather_rays: 4,
             shadow_rays: 2,
-            cache_stride: 4,
+            cache_stride: 16,
             edge_spp: 256,
             skip: true,
             alpha: 2.0 / 3.0,

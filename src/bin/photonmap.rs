@@ -105,7 +105,7 @@ struct Cli {
     shadow_rays: u32,
     /// Irradiance is precomputed at every N-th stored global photon, and
     /// final-gather rays read the nearest precomputed value.
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     cache_stride: u32,
     /// Samples of the light seen in pixels on the rim of a light's image
     /// (directly or in mirrors and glass; 0: no extra samples).

@@ -12,7 +12,13 @@ use crate::math::Color;
 use glam::{EulerRot, Mat3, Vec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
+use std::collections::HashMap;
 use std::f32::consts::PI;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// Grid cells of the irradiance cache's index, as a fraction of the lookup
+/// radius (twice the median estimate radius).
+const CELL_FRACTION: f32 = 0.75;
 
 /// Photons whose stored normal is further than this (cosine) from the query
 /// normal lie on another surface (the wall in a corner, the far side of a
@@ -330,15 +336,25 @@ fn order_free_sum(terms: &[Color]) -> Color {
 /// Irradiance precomputed at a subset of the global photons (Christensen
 /// 1999): final-gather rays then read one nearby value instead of running a
 /// k-nearest estimate each.
+///
+/// Gather rays land anywhere in the scene, so their lookups share no cache
+/// lines, and a kd-tree nearest-neighbour search over the points cost ~1 µs
+/// each (a quarter of the default camera pass, notes/performance.md). The
+/// points are therefore also bucketed by the cell of a uniform grid (cells
+/// hashed, each cell's points contiguous): a lookup reads its own cell's few
+/// points and takes the nearest one facing like the query; only where the
+/// cell holds none does it search the tree.
 pub struct IrradianceCache {
     points: Vec<CachePoint>,
     tree: PointTree,
+    cells: CellIndex,
     /// Squared search radius of a lookup.
     lookup_r2: f32,
 }
 
 #[derive(Clone, Copy, Debug)]
 struct CachePoint {
+    position: [f32; 3],
     irradiance: [f32; 3],
     normal: [i8; 4],
 }
@@ -349,34 +365,109 @@ impl CachePoint {
     }
 }
 
+/// Cells of a uniform grid, hashed: each occupied cell's range of points
+/// (sorted by cell).
+struct CellIndex {
+    lo: Vec3,
+    inv_cell: f32,
+    ranges: HashMap<u64, (u32, u32), BuildHasherDefault<CellHasher>>,
+}
+
+/// Bits per axis of a cell key; coarser cells where a grid would need more.
+const CELL_BITS: u32 = 21;
+
+impl CellIndex {
+    fn key(&self, x: Vec3) -> Option<u64> {
+        let c = ((x - self.lo) * self.inv_cell).floor();
+        // Outside the grid (or not finite): no cell.
+        if !(c.min_element() >= 0.0 && c.max_element() < (1u32 << CELL_BITS) as f32) {
+            return None;
+        }
+        Some(c.x as u64 | ((c.y as u64) << CELL_BITS) | ((c.z as u64) << (2 * CELL_BITS)))
+    }
+}
+
+/// Cell keys are packed coordinates, already well spread: one multiply
+/// (Fibonacci hashing) mixes them enough, where std's SipHash would cost
+/// more than the rest of a lookup.
+#[derive(Default)]
+struct CellHasher(u64);
+
+impl Hasher for CellHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0 ^ v).wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(26);
+    }
+}
+
 impl IrradianceCache {
     /// Precomputes irradiance at every `stride`-th photon of `map` from its
     /// `k` nearest within `r_max`.
     pub fn build(map: &PhotonMap, stride: usize, k: usize, r_max: f32) -> Self {
         let stride = stride.max(1);
-        let computed: Vec<(Vec3, CachePoint, f32)> = map
+        let computed: Vec<(CachePoint, f32)> = map
             .photons
             .par_iter()
             .step_by(stride)
             .map_init(Scratch::default, |buf, p| {
                 let n = p.surface_normal();
                 let (e, r2) = map.irradiance(p.position(), n, k, r_max, buf);
-                (p.position(), CachePoint { irradiance: e.to_array(), normal: quantize_normal(n) }, r2)
+                let point = CachePoint {
+                    position: p.position().to_array(),
+                    irradiance: e.to_array(),
+                    normal: quantize_normal(n),
+                };
+                (point, r2)
             })
             .collect();
         // Search as far as twice the median estimate radius: far enough to
         // find a cached point on the same surface almost everywhere, near
         // enough to stay within the blur the estimates already have.
-        let mut radii: Vec<f32> = computed.iter().map(|c| c.2).collect();
-        let lookup_r2 = if radii.is_empty() {
+        let mut radii: Vec<f32> = computed.iter().map(|c| c.1).collect();
+        let median_r2 = if radii.is_empty() {
             0.0
         } else {
             let mid = radii.len() / 2;
-            let median = *radii.select_nth_unstable_by(mid, f32::total_cmp).1;
-            (4.0 * median).min(r_max * r_max)
+            *radii.select_nth_unstable_by(mid, f32::total_cmp).1
         };
-        let tree = PointTree::build(computed.par_iter().map(|c| c.0));
-        IrradianceCache { points: computed.into_iter().map(|c| c.1).collect(), tree, lookup_r2 }
+        let lookup_r2 = (4.0 * median_r2).min(r_max * r_max);
+        let mut points: Vec<CachePoint> = computed.into_iter().map(|c| c.0).collect();
+        let cells = Self::bucket(&mut points, lookup_r2.sqrt() * CELL_FRACTION);
+        let tree = PointTree::build(points.par_iter().map(|c| Vec3::from(c.position)));
+        IrradianceCache { points, tree, cells, lookup_r2 }
+    }
+
+    /// Sorts the points by grid cell and indexes each cell's range.
+    fn bucket(points: &mut [CachePoint], cell: f32) -> CellIndex {
+        let (lo, hi) = points.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| {
+            (lo.min(Vec3::from(p.position)), hi.max(Vec3::from(p.position)))
+        });
+        let extent = (hi - lo).max_element();
+        let fine_enough = extent / ((1u32 << CELL_BITS) - 2) as f32;
+        let cell = if cell.is_finite() && cell > fine_enough { cell } else { fine_enough.max(f32::MIN_POSITIVE) };
+        let mut index = CellIndex { lo, inv_cell: 1.0 / cell, ranges: HashMap::default() };
+        if points.is_empty() || !extent.is_finite() || !index.inv_cell.is_finite() {
+            return index;
+        }
+        // Stable: equal cells keep the points' (Morton) order.
+        points.par_sort_by_cached_key(|p| index.key(Vec3::from(p.position)));
+        let mut start = 0;
+        while start < points.len() {
+            let key = index.key(Vec3::from(points[start].position));
+            let end = start + points[start..].iter().take_while(|p| index.key(Vec3::from(p.position)) == key).count();
+            if let Some(key) = key {
+                index.ranges.insert(key, (start as u32, end as u32));
+            }
+            start = end;
+        }
+        index
     }
 
     pub fn len(&self) -> usize {
@@ -387,9 +478,22 @@ impl IrradianceCache {
         self.points.is_empty()
     }
 
-    /// Irradiance of the nearest cached point on a surface facing like `n`;
-    /// zero where no photon came near.
+    /// Irradiance of a cached point near `x`, within the lookup radius, on
+    /// a surface facing like `n`: the nearest such point in `x`'s grid cell,
+    /// else the nearest anywhere; zero where no photon came near.
     pub fn lookup(&self, x: Vec3, n: Vec3, scratch: &mut Scratch) -> Color {
+        if let Some(&(start, end)) = self.cells.key(x).and_then(|key| self.cells.ranges.get(&key)) {
+            let mut best: Option<(f32, &CachePoint)> = None;
+            for p in &self.points[start as usize..end as usize] {
+                let d2 = Vec3::from(p.position).distance_squared(x);
+                if d2 <= self.lookup_r2 && best.is_none_or(|b| d2 < b.0) && p.faces(n) {
+                    best = Some((d2, p));
+                }
+            }
+            if let Some((_, p)) = best {
+                return Vec3::from(p.irradiance);
+            }
+        }
         // Almost always the nearest point is on the same surface; only near
         // edges and corners is a wider search needed.
         match self.tree.nearest(x) {
@@ -506,5 +610,45 @@ mod tests {
         assert!((cached / direct - 1.0).abs() < 0.25, "{cached} {direct}");
         assert!((direct / 6250.0 - 1.0).abs() < 0.2, "{direct}");
         assert_eq!(cache.lookup(x, -Vec3::Y, &mut buf), Color::ZERO);
+    }
+
+    /// In a corner a lookup's grid cell holds points of both surfaces: each
+    /// query gets its own surface's irradiance, from its cell or, where the
+    /// cell holds only the other surface's points, from the tree. Every
+    /// answer is the irradiance of a point that faces the query and lies
+    /// within the lookup radius.
+    #[test]
+    fn irradiance_cache_keeps_surfaces_apart_in_a_corner() {
+        let mut rng = stream(13, Domain::Camera, 0);
+        // Floor y = 0 (power 1) and wall x = 0 (power 3), 4 x 4 each.
+        let photons: Vec<Photon> = (0..100_000)
+            .map(|i| {
+                let u = next_2d(&mut rng) * 4.0;
+                if i % 2 == 0 {
+                    Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y, Vec3::Y)
+                } else {
+                    Photon::new(Vec3::new(0.0, u.x, u.y), Color::splat(3.0), Vec3::X, Vec3::X)
+                }
+            })
+            .collect();
+        let map = PhotonMap::build(photons);
+        let cache = IrradianceCache::build(&map, 4, 100, 1.0);
+        let mut buf = Scratch::default();
+        let (floor, wall) = (50_000.0 / 16.0, 3.0 * 50_000.0 / 16.0);
+        for i in 0..200 {
+            let d = 1e-3 + 0.4 * i as f32 / 200.0;
+            let z = 0.5 + 3.0 * (i % 17) as f32 / 17.0;
+            let on_floor = cache.lookup(Vec3::new(d, 0.0, z), Vec3::Y, &mut buf).x;
+            let on_wall = cache.lookup(Vec3::new(0.0, d, z), Vec3::X, &mut buf).x;
+            // Near the corner the estimates themselves lose up to half
+            // their disk; far from the other surface is all that is asked.
+            assert!(on_floor > 0.3 * floor && on_floor < 1.3 * floor, "floor at {d}: {on_floor}");
+            assert!(on_wall > 0.3 * wall && on_wall < 1.3 * wall, "wall at {d}: {on_wall}");
+        }
+        // Points facing the other way exist nowhere: nothing is returned.
+        assert_eq!(cache.lookup(Vec3::new(0.2, 0.0, 2.0), -Vec3::Y, &mut buf), Color::ZERO);
+        // Outside the grid and far from every point: zero, not a far value.
+        assert_eq!(cache.lookup(Vec3::new(50.0, 50.0, 50.0), Vec3::Y, &mut buf), Color::ZERO);
+        assert_eq!(cache.lookup(Vec3::splat(f32::NAN), Vec3::Y, &mut buf), Color::ZERO);
     }
 }
