@@ -5,7 +5,7 @@
 
 use crate::math::Ray;
 use crate::shape::{Departure, RayShear, Shape, ShapeHit};
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 const BINS: usize = 16;
 /// Up to this many primitives a flat loop beats the hierarchy. The default
@@ -133,7 +133,8 @@ impl Accel {
             }
             return;
         }
-        let inv = ray.dir.recip();
+        let inv = Vec3A::from(ray.dir).recip();
+        let origin = Vec3A::from(ray.origin);
         let mut stack = [0u32; 64];
         let mut top = 0usize;
         let mut node = 0u32;
@@ -147,8 +148,8 @@ impl Accel {
                 }
             } else {
                 let (a, b) = (n.first, n.first + 1);
-                let ta = entry(&self.nodes[a as usize], ray, inv);
-                let tb = entry(&self.nodes[b as usize], ray, inv);
+                let ta = entry(&self.nodes[a as usize], origin, inv);
+                let tb = entry(&self.nodes[b as usize], origin, inv);
                 let (near, t_near, far, t_far) = if ta <= tb { (a, ta, b, tb) } else { (b, tb, a, ta) };
                 if enters(t_near, t_limit) {
                     if enters(t_far, t_limit) && top < stack.len() {
@@ -166,7 +167,7 @@ impl Accel {
                 }
                 top -= 1;
                 node = stack[top];
-                if enters(entry(&self.nodes[node as usize], ray, inv), t_limit) {
+                if enters(entry(&self.nodes[node as usize], origin, inv), t_limit) {
                     break;
                 }
             }
@@ -182,11 +183,15 @@ fn enters(t: f32, t_limit: f32) -> bool {
 }
 
 /// Distance at which the ray enters the box (0 if it starts inside), or
-/// infinity if it misses. Written so that a NaN from 0 * inf never counts
-/// as a hit or a miss wrongly: max/min ignore a NaN operand.
-fn entry(n: &Node, ray: &Ray, inv: Vec3) -> f32 {
-    let t0 = (n.min - ray.origin) * inv;
-    let t1 = (n.max - ray.origin) * inv;
+/// infinity if it misses. The slabs are computed four lanes at a time; a
+/// lane is NaN only from 0 * inf (a ray parallel to a slab, starting on its
+/// plane), and the lanes are then reduced with `f32::max`/`min`, which
+/// ignore a NaN operand: such a slab constrains nothing, so a box is never
+/// dropped for it (at worst a box the ray only grazes is visited).
+#[inline(always)]
+fn entry(n: &Node, origin: Vec3A, inv: Vec3A) -> f32 {
+    let t0 = (Vec3A::from(n.min) - origin) * inv;
+    let t1 = (Vec3A::from(n.max) - origin) * inv;
     let near = t0.min(t1);
     let far = t0.max(t1);
     let t_in = near.x.max(near.y).max(near.z).max(0.0);
