@@ -241,7 +241,6 @@ fn run(cli: Cli) -> Result<(), Error> {
         edge_spp: cli.edge_spp,
         cache_stride: cli.cache_stride as usize,
         skip: !cli.no_skip,
-        ..Settings::default()
     };
     // Refuse before allocating: a map that cannot fit would abort the
     // process half-way, after minutes of work.
