@@ -225,12 +225,13 @@ impl PhotonMap {
     }
 
     /// Finds the `k` nearest photons within `r_max` of `x` (fewer if fewer are
-    /// there) and keeps in the scratch those on a surface facing like `n`.
+    /// there) and leaves them in the scratch; the estimates keep those on a
+    /// surface facing like `n`.
     /// The estimate's disk has the k-th photon on its rim, or radius `r_max`
     /// when fewer than `k` were found (a fixed-radius estimate). Photons on
     /// other surfaces (a wall in a corner) take part in fixing the radius but
     /// add no flux: the disk is the surface's own.
-    pub fn gather(&self, x: Vec3, n: Vec3, k: usize, r_max: f32, scratch: &mut Scratch) -> Gathered {
+    fn gather(&self, x: Vec3, k: usize, r_max: f32, scratch: &mut Scratch) -> Gathered {
         let r_max2 = r_max * r_max;
         if self.certainly_empty(x, r_max) {
             // What the search below would conclude after descending the tree
@@ -249,7 +250,10 @@ impl PhotonMap {
             if buf.len() >= k || r2 >= r_max2 {
                 break;
             }
-            r2 = (r2 * 4.0).min(r_max2);
+            // Photons lie on surfaces, so their count grows with r^2: aim at
+            // k with a margin, by at most 4x the area.
+            let grow = (1.3 * k as f32 / buf.len().max(1) as f32).clamp(1.5, 4.0);
+            r2 = (r2 * grow).min(r_max2);
         }
         let r2 = if k > 0 && buf.len() >= k {
             buf.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
@@ -258,12 +262,18 @@ impl PhotonMap {
         } else {
             r_max2
         };
-        scratch.hint_r2 = if r2 < r_max2 { r2 * 1.5 } else { r_max2 };
-        buf.retain(|&(_, i)| self.photons[i as usize].surface_normal().dot(n) >= NORMAL_COSINE);
+        scratch.hint_r2 = if r2 < r_max2 { r2 * 1.25 } else { r_max2 };
         // The visit order depends on the radius searched, hence on the hint,
         // hence on which thread ran the previous query: the estimates sum
         // with `order_free_sum`, whose result does not depend on the order.
         Gathered { r2, count: buf.len() }
+    }
+
+    /// Whether photon `i` lies on a surface facing like `n` (photons on
+    /// other surfaces help fix the radius but add no flux).
+    #[inline]
+    fn faces(&self, i: u32, n: Vec3) -> bool {
+        self.photons[i as usize].surface_normal().dot(n) >= NORMAL_COSINE
     }
 
     /// Irradiance at `x` with a box kernel: sum of flux / (pi r^2). When the
@@ -271,7 +281,7 @@ impl PhotonMap {
     /// out: for a uniform density the k-1 photons strictly inside the disk
     /// give an unbiased estimate, all k would overestimate by k / (k - 1).
     pub fn irradiance(&self, x: Vec3, n: Vec3, k: usize, r_max: f32, buf: &mut Scratch) -> (Color, f32) {
-        let g = self.gather(x, n, k, r_max, buf);
+        let g = self.gather(x, k, r_max, buf);
         if g.count == 0 || !(g.r2 > 0.0) {
             return (Color::ZERO, g.r2);
         }
@@ -280,7 +290,7 @@ impl PhotonMap {
         buf.terms.extend(
             buf.buf
                 .iter()
-                .filter(|&&(d2, _)| !on_rim_excluded || d2 < g.r2)
+                .filter(|&&(d2, i)| (!on_rim_excluded || d2 < g.r2) && self.faces(i, n))
                 .map(|&(_, i)| self.photons[i as usize].flux()),
         );
         let flux = order_free_sum(&buf.terms);
@@ -291,14 +301,18 @@ impl PhotonMap {
     /// estimated with Jensen's cone filter (k = 1: weight 1 - d / r,
     /// normalised by 1 / (1 - 2/3)), which keeps caustic edges sharp.
     pub fn radiance_cone(&self, x: Vec3, n: Vec3, rho: Color, k: usize, r_max: f32, buf: &mut Scratch) -> Color {
-        let g = self.gather(x, n, k, r_max, buf);
+        let g = self.gather(x, k, r_max, buf);
         if g.count == 0 || !(g.r2 > 0.0) {
             return Color::ZERO;
         }
         let r = g.r2.sqrt();
         buf.terms.clear();
-        buf.terms
-            .extend(buf.buf.iter().map(|&(d2, i)| self.photons[i as usize].flux() * (1.0 - d2.sqrt() / r).max(0.0)));
+        buf.terms.extend(
+            buf.buf
+                .iter()
+                .filter(|&&(_, i)| self.faces(i, n))
+                .map(|&(d2, i)| self.photons[i as usize].flux() * (1.0 - d2.sqrt() / r).max(0.0)),
+        );
         let flux = order_free_sum(&buf.terms);
         rho / PI * flux * 3.0 / (PI * g.r2)
     }
