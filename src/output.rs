@@ -71,13 +71,22 @@ pub fn write(path: &Path, film: &Film, tonemap: ToneMap, exposure: f32) -> Resul
     })
 }
 
+/// Float RGB, RLE-compressed 64x64 tiles (exr's fast lossless default),
+/// written in increasing line order: the tiles are compressed in parallel,
+/// and an unspecified order would store them as they finish, so the same
+/// pixels would give different files from run to run.
 fn write_exr(tmp: &Path, film: &Film) -> Result<()> {
+    use exr::prelude::*;
     let w = film.width as usize;
-    exr::prelude::write_rgb_file(tmp, w, film.height as usize, |x, y| {
+    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
         let c = film.pixels[y * w + x];
         (c.x, c.y, c.z)
-    })
-    .map_err(|e| Error::Encode { path: tmp.to_owned(), message: e.to_string() })
+    });
+    let encoding = Encoding { line_order: LineOrder::Increasing, ..Encoding::FAST_LOSSLESS };
+    Image::from_encoded_channels((w, film.height as usize), encoding, channels)
+        .write()
+        .to_file(tmp)
+        .map_err(|e| crate::error::Error::Encode { path: tmp.to_owned(), message: e.to_string() })
 }
 
 fn write_rgb8(tmp: &Path, film: &Film, tonemap: ToneMap, exposure: f32, format: Format) -> Result<()> {

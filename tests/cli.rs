@@ -41,6 +41,25 @@ fn renders_exr_png_and_ppm_in_one_run() {
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 3);
 }
 
+/// The same seed gives the same file, byte for byte, on any number of
+/// threads: the pixels are thread-independent (tests/determinism.rs) and
+/// the EXR's tiles, compressed in parallel, are stored in a fixed order.
+#[test]
+fn the_same_seed_writes_the_same_exr_bytes_on_1_and_3_threads() {
+    let dir = scratch_dir("cli-bytes");
+    let files: Vec<Vec<u8>> = ["1", "3"]
+        .iter()
+        .map(|threads| {
+            let out = dir.join(format!("t{threads}.exr"));
+            let args = ["--photons", "2e4", "--width", "160", "--height", "136", "--spp", "1", "--quiet"];
+            let o = photonmap(&[&args[..], &["--threads", threads, out.to_str().unwrap()]].concat());
+            assert!(o.status.success(), "{}", stderr(&o));
+            std::fs::read(&out).unwrap()
+        })
+        .collect();
+    assert!(files[0] == files[1], "EXR files differ between 1 and 3 threads");
+}
+
 #[test]
 fn photon_counts_accept_plain_and_e_notation() {
     for ok in ["1000000", "1e6", "2.5e5", "0"] {
@@ -144,6 +163,7 @@ fn help_documents_every_option_with_its_default() {
         "--caustic-radius",
         "--gather-rays",
         "--shadow-rays",
+        "--cache-stride",
         "--edge-spp",
         "--tonemap",
         "--exposure",

@@ -12,9 +12,7 @@ use crate::math::Color;
 use glam::{EulerRot, Mat3, Vec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
-use std::collections::HashMap;
 use std::f32::consts::PI;
-use std::hash::{BuildHasherDefault, Hasher};
 
 /// Grid cells of the irradiance cache's index, as a fraction of the lookup
 /// radius (twice the median estimate radius).
@@ -243,24 +241,33 @@ impl PhotonMap {
         let buf = &mut scratch.buf;
         // Search a growing radius from the hint: the result is the same as one
         // search at r_max, at the cost of the photons near the answer only.
-        let mut r2 = if scratch.hint_r2 > 0.0 { scratch.hint_r2.min(r_max2) } else { r_max2 * 1e-4 };
-        loop {
+        // It must not depend on the hint (the thread's previous query), so
+        // a search whose k-th photon lies within 1e-4 of its rim is repeated
+        // wider, in case the tree's pruning, which rounds, kept or dropped a
+        // photon at the rim depending on the radius asked.
+        let mut r2 = if k > 0 && scratch.hint_r2 > 0.0 { scratch.hint_r2.min(r_max2) } else { r_max2 };
+        let r2 = loop {
             buf.clear();
             self.tree.within(x, r2, buf);
-            if buf.len() >= k || r2 >= r_max2 {
-                break;
+            if k > 0 && buf.len() >= k {
+                // Photons at equal distances (f32 squares do tie, a few
+                // times per million estimates) are ranked by index.
+                buf.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                buf.truncate(k);
+                let kth = buf[k - 1].0;
+                if kth <= r2 * (1.0 - 1e-4) || r2 >= r_max2 {
+                    break kth;
+                }
+                r2 = (r2 * 1.5).min(r_max2);
+                continue;
+            }
+            if r2 >= r_max2 {
+                break r_max2;
             }
             // Photons lie on surfaces, so their count grows with r^2: aim at
             // k with a margin, by at most 4x the area.
             let grow = (1.3 * k as f32 / buf.len().max(1) as f32).clamp(1.5, 4.0);
             r2 = (r2 * grow).min(r_max2);
-        }
-        let r2 = if k > 0 && buf.len() >= k {
-            buf.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
-            buf.truncate(k);
-            buf[k - 1].0
-        } else {
-            r_max2
         };
         scratch.hint_r2 = if r2 < r_max2 { r2 * 1.25 } else { r_max2 };
         // The visit order depends on the radius searched, hence on the hint,
@@ -380,15 +387,28 @@ impl CachePoint {
 }
 
 /// Cells of a uniform grid, hashed: each occupied cell's range of points
-/// (sorted by cell).
+/// (sorted by cell). An open-addressing table of 16-byte slots, so that a
+/// probe usually costs one cache line (a `HashMap` reads its control bytes
+/// and its slots from two places).
 struct CellIndex {
     lo: Vec3,
     inv_cell: f32,
-    ranges: HashMap<u64, (u32, u32), BuildHasherDefault<CellHasher>>,
+    slots: Vec<CellSlot>,
+    /// log2 of the slot count.
+    bits: u32,
+}
+
+#[derive(Clone, Copy)]
+struct CellSlot {
+    key: u64,
+    start: u32,
+    end: u32,
 }
 
 /// Bits per axis of a cell key; coarser cells where a grid would need more.
 const CELL_BITS: u32 = 21;
+/// Keys use 63 bits, so this one marks an empty slot.
+const EMPTY: u64 = u64::MAX;
 
 impl CellIndex {
     fn key(&self, x: Vec3) -> Option<u64> {
@@ -399,25 +419,39 @@ impl CellIndex {
         }
         Some(c.x as u64 | ((c.y as u64) << CELL_BITS) | ((c.z as u64) << (2 * CELL_BITS)))
     }
-}
 
-/// Cell keys are packed coordinates, already well spread: one multiply
-/// (Fibonacci hashing) mixes them enough, where std's SipHash would cost
-/// more than the rest of a lookup.
-#[derive(Default)]
-struct CellHasher(u64);
-
-impl Hasher for CellHasher {
-    fn finish(&self) -> u64 {
-        self.0
+    /// The first slot to probe: Fibonacci hashing (one multiply) spreads
+    /// the packed coordinates well enough.
+    fn home(&self, key: u64) -> usize {
+        (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.bits)) as usize
     }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(b as u64);
+
+    fn insert(&mut self, key: u64, start: u32, end: u32) {
+        let mask = self.slots.len() - 1;
+        let mut i = self.home(key);
+        while self.slots[i].key != EMPTY {
+            i = (i + 1) & mask;
         }
+        self.slots[i] = CellSlot { key, start, end };
     }
-    fn write_u64(&mut self, v: u64) {
-        self.0 = (self.0 ^ v).wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(26);
+
+    fn range(&self, x: Vec3) -> Option<(u32, u32)> {
+        if self.slots.is_empty() {
+            return None;
+        }
+        let key = self.key(x)?;
+        let mask = self.slots.len() - 1;
+        let mut i = self.home(key);
+        loop {
+            let slot = self.slots[i];
+            if slot.key == key {
+                return Some((slot.start, slot.end));
+            }
+            if slot.key == EMPTY {
+                return None;
+            }
+            i = (i + 1) & mask;
+        }
     }
 }
 
@@ -466,20 +500,27 @@ impl IrradianceCache {
         let extent = (hi - lo).max_element();
         let fine_enough = extent / ((1u32 << CELL_BITS) - 2) as f32;
         let cell = if cell.is_finite() && cell > fine_enough { cell } else { fine_enough.max(f32::MIN_POSITIVE) };
-        let mut index = CellIndex { lo, inv_cell: 1.0 / cell, ranges: HashMap::default() };
+        let mut index = CellIndex { lo, inv_cell: 1.0 / cell, slots: Vec::new(), bits: 0 };
         if points.is_empty() || !extent.is_finite() || !index.inv_cell.is_finite() {
             return index;
         }
         // Stable: equal cells keep the points' (Morton) order.
         points.par_sort_by_cached_key(|p| index.key(Vec3::from(p.position)));
+        let mut ranges = Vec::new();
         let mut start = 0;
         while start < points.len() {
             let key = index.key(Vec3::from(points[start].position));
             let end = start + points[start..].iter().take_while(|p| index.key(Vec3::from(p.position)) == key).count();
             if let Some(key) = key {
-                index.ranges.insert(key, (start as u32, end as u32));
+                ranges.push((key, start as u32, end as u32));
             }
             start = end;
+        }
+        // At most half full: probes stay short.
+        index.bits = (2 * ranges.len()).next_power_of_two().trailing_zeros().max(1);
+        index.slots = vec![CellSlot { key: EMPTY, start: 0, end: 0 }; 1 << index.bits];
+        for (key, start, end) in ranges {
+            index.insert(key, start, end);
         }
         index
     }
@@ -496,7 +537,7 @@ impl IrradianceCache {
     /// a surface facing like `n`: the nearest such point in `x`'s grid cell,
     /// else the nearest anywhere; zero where no photon came near.
     pub fn lookup(&self, x: Vec3, n: Vec3, scratch: &mut Scratch) -> Color {
-        if let Some(&(start, end)) = self.cells.key(x).and_then(|key| self.cells.ranges.get(&key)) {
+        if let Some((start, end)) = self.cells.range(x) {
             let mut best: Option<(f32, &CachePoint)> = None;
             for p in &self.points[start as usize..end as usize] {
                 let d2 = Vec3::from(p.position).distance_squared(x);
@@ -664,5 +705,8 @@ mod tests {
         // Outside the grid and far from every point: zero, not a far value.
         assert_eq!(cache.lookup(Vec3::new(50.0, 50.0, 50.0), Vec3::Y, &mut buf), Color::ZERO);
         assert_eq!(cache.lookup(Vec3::splat(f32::NAN), Vec3::Y, &mut buf), Color::ZERO);
+        // A cache over no photons answers zero everywhere.
+        let empty = IrradianceCache::build(&PhotonMap::build(Vec::new()), 4, 100, 1.0);
+        assert_eq!(empty.lookup(Vec3::new(0.2, 0.0, 2.0), Vec3::Y, &mut buf), Color::ZERO);
     }
 }
