@@ -646,6 +646,42 @@ mod tests {
         assert_eq!(empty.irradiance(Vec3::ZERO, Vec3::Z, 10, 1.0, &mut buf).0, Color::ZERO);
     }
 
+    /// Estimates start their search from the radius the thread's previous
+    /// query needed; the answer must not depend on that history: the same
+    /// bits with a fresh scratch per query, and along the path either way.
+    #[test]
+    fn estimates_do_not_depend_on_the_previous_query() {
+        let mut rng = stream(14, Domain::Camera, 0);
+        // A floor with a denser stripe, and a wall: radii vary along the path.
+        let photons: Vec<Photon> = (0..60_000)
+            .map(|i| {
+                let u = next_2d(&mut rng) * 4.0;
+                match i % 3 {
+                    0 => Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y, Vec3::Y),
+                    1 => Photon::new(Vec3::new(1.5 + u.x / 8.0, 0.0, u.y), Color::splat(2.0), Vec3::Y, Vec3::Y),
+                    _ => Photon::new(Vec3::new(0.0, u.x, u.y), Color::splat(0.5), Vec3::X, Vec3::X),
+                }
+            })
+            .collect();
+        let map = PhotonMap::build(photons);
+        let path: Vec<Vec3> =
+            (0..300).map(|i| Vec3::new(0.01 * i as f32 + 0.001, 0.0, 2.0 + 0.003 * i as f32)).collect();
+        let estimate = |x: Vec3, s: &mut Scratch| {
+            let cone = map.radiance_cone(x, Vec3::Y, Color::ONE, 50, 0.1, s);
+            let (e, r2) = map.irradiance(x, Vec3::Y, 80, 0.1, s);
+            (cone.to_array(), e.to_array(), r2)
+        };
+        let fresh: Vec<_> = path.iter().map(|&x| estimate(x, &mut Scratch::default())).collect();
+        let mut s = Scratch::default();
+        let forward: Vec<_> = path.iter().map(|&x| estimate(x, &mut s)).collect();
+        let mut backward: Vec<_> = path.iter().rev().map(|&x| estimate(x, &mut s)).collect();
+        backward.reverse();
+        assert_eq!(forward, fresh);
+        assert_eq!(backward, fresh);
+        // Some estimates found fewer than k within the cap, some more.
+        assert!(fresh.iter().any(|f| f.2 < 0.1 * 0.1) && fresh.iter().any(|f| f.2 == 0.1f32 * 0.1));
+    }
+
     #[test]
     fn irradiance_cache_agrees_with_direct_estimate() {
         let mut rng = stream(12, Domain::Camera, 0);
