@@ -15,7 +15,8 @@ case "$mode" in
       mkdir -p "target/criterion/$d"
       cp -r "notes/bench-baseline/$d/." "target/criterion/$d/"
     done
-    cargo bench --bench phases -- --baseline committed "$@"
+    # Lenient: a bench added since the baseline was saved is measured, not an error.
+    cargo bench --bench phases -- --baseline-lenient committed "$@"
     ;;
   save)
     cargo bench --bench phases -- --save-baseline committed "$@"
