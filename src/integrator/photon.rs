@@ -34,6 +34,17 @@ const SPLIT_DEPTH: u32 = 2;
 /// internal reflection; its share is negligible).
 const MAX_SPECULAR_DEPTH: u32 = 24;
 
+/// Gather rays traced before their cache reads (see `indirect`).
+const GATHER_BATCH: usize = 8;
+
+/// A gather ray's diffuse hit: where the cache is read, and with what weight.
+#[derive(Clone, Copy, Default)]
+struct GatherHit {
+    point: glam::Vec3,
+    normal: glam::Vec3,
+    weight: Color,
+}
+
 /// Quality settings of the estimator.
 #[derive(Clone, Copy, Debug)]
 pub struct PhotonEstimator {
@@ -171,6 +182,12 @@ impl PhotonIntegrator<'_> {
     }
 
     /// Light → … diffuse y → (specular*) → x: final gathering.
+    ///
+    /// The rays are traced first and the cache read after, a batch at a
+    /// time: each read is a cache miss (gather hits land anywhere in the
+    /// scene), and announcing a batch's addresses before reading any lets
+    /// the memory system fetch them together instead of one after another.
+    /// The random numbers are drawn in the same order either way.
     fn indirect(&self, hit: &Hit, n: glam::Vec3, rho: Color, ctx: &mut Context) -> Color {
         let count = self.settings.gather_rays;
         if count == 0 || self.cache.is_empty() {
@@ -178,10 +195,23 @@ impl PhotonIntegrator<'_> {
         }
         let frame = Frame::from_normal(n);
         let mut sum = Color::ZERO;
-        for g in 0..count {
-            let dir = frame.to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(ctx.rng)))).normalize();
-            let (ray, dep) = hit.spawn(dir);
-            sum += self.gather(ray, dep, ctx);
+        let mut batch = [GatherHit::default(); GATHER_BATCH];
+        let mut g = 0;
+        while g < count {
+            let size = (count - g).min(GATHER_BATCH as u32) as usize;
+            for slot in batch.iter_mut().take(size) {
+                let dir = frame.to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(ctx.rng)))).normalize();
+                let (ray, dep) = hit.spawn(dir);
+                *slot = self.gather_hit(ray, dep, ctx);
+                self.cache.prefetch_cell(slot.point);
+                g += 1;
+            }
+            for h in &batch[..size] {
+                self.cache.prefetch_points(h.point);
+            }
+            for h in &batch[..size] {
+                sum += self.read_cache(h, ctx);
+            }
         }
         // Cosine-weighted directions: f cos / pdf = (rho / pi) cos / (cos / pi) = rho.
         rho * sum / count as f32
@@ -190,10 +220,26 @@ impl PhotonIntegrator<'_> {
     /// Radiance arriving along a gather ray that was reflected by a diffuse
     /// surface at least once before: followed through mirrors and glass to
     /// the first diffuse y, where the global map's irradiance is read.
-    fn gather(&self, mut ray: Ray, mut dep: Departure, ctx: &mut Context) -> Color {
+    fn gather(&self, ray: Ray, dep: Departure, ctx: &mut Context) -> Color {
         if self.cache.is_empty() {
             return Color::ZERO;
         }
+        let h = self.gather_hit(ray, dep, ctx);
+        self.read_cache(&h, ctx)
+    }
+
+    fn read_cache(&self, h: &GatherHit, ctx: &mut Context) -> Color {
+        if h.weight == Color::ZERO {
+            return Color::ZERO;
+        }
+        h.weight * self.cache.lookup(h.point, h.normal, ctx.scratch)
+    }
+
+    /// Where a gather ray, followed through mirrors and glass, meets its
+    /// first diffuse surface y, and the weight (path throughput times
+    /// rho_y / pi) that y's irradiance takes; a zero weight where it meets
+    /// none.
+    fn gather_hit(&self, mut ray: Ray, mut dep: Departure, ctx: &mut Context) -> GatherHit {
         let mut weight = Color::ONE;
         for _ in 0..MAX_SPECULAR_DEPTH {
             ctx.tally.rays += 1;
@@ -203,11 +249,9 @@ impl PhotonIntegrator<'_> {
             weight *= self.scene.transmittance(Some(dep), y.t);
             let material = *self.scene.material(y.prim);
             if let Some(rho_y) = material.diffuse_rho() {
-                let n_y = y.facing_normal(ray.dir);
-                let e = self.cache.lookup(y.point, n_y, ctx.scratch);
                 // A Phong surface's mirror lobe is not followed here: its
                 // share of indirect light is left out (notes/scene-format.md).
-                return weight * rho_y / PI * e;
+                return GatherHit { point: y.point, normal: y.facing_normal(ray.dir), weight: weight * rho_y / PI };
             }
             let next_dir = match material {
                 Material::Mirror { reflectance } => {
@@ -232,7 +276,7 @@ impl PhotonIntegrator<'_> {
             };
             (ray, dep) = y.spawn(next_dir.normalize());
         }
-        Color::ZERO
+        GatherHit::default()
     }
 
     fn checked(&self, c: Color, estimator: &'static str, ctx: &mut Context) -> Color {

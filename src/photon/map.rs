@@ -386,6 +386,19 @@ impl CachePoint {
     }
 }
 
+/// A hint to the processor to bring `value`'s cache line in; nothing else.
+#[inline(always)]
+fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch has no effect on memory or registers; the address
+    // is that of a live reference.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>((value as *const T).cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
+}
+
 /// Cells of a uniform grid, hashed: each occupied cell's range of points
 /// (sorted by cell). An open-addressing table of 16-byte slots, so that a
 /// probe usually costs one cache line (a `HashMap` reads its control bytes
@@ -531,6 +544,22 @@ impl IrradianceCache {
 
     pub fn is_empty(&self) -> bool {
         self.points.is_empty()
+    }
+
+    /// Starts fetching the table slot a lookup at `x` will read first.
+    pub fn prefetch_cell(&self, x: Vec3) {
+        if let Some(key) = self.cells.key(x).filter(|_| !self.cells.slots.is_empty()) {
+            prefetch(&self.cells.slots[self.cells.home(key)]);
+        }
+    }
+
+    /// Starts fetching the points of `x`'s cell (after [`Self::prefetch_cell`]
+    /// had time to bring in the slot).
+    pub fn prefetch_points(&self, x: Vec3) {
+        if let Some((start, end)) = self.cells.range(x) {
+            prefetch(&self.points[start as usize]);
+            prefetch(&self.points[end as usize - 1]);
+        }
     }
 
     /// Irradiance of a cached point near `x`, within the lookup radius, on
