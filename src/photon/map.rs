@@ -28,7 +28,8 @@ const NORMAL_COSINE: f32 = 0.9;
 /// queries need similar radii, so the next search starts there.
 #[derive(Default, Debug)]
 pub struct Scratch {
-    buf: Vec<(f32, u32)>,
+    /// Photons found, as [`found`] keys.
+    buf: Vec<u64>,
     /// The terms of an estimate's sum.
     terms: Vec<Color>,
     hint_r2: f32,
@@ -36,6 +37,22 @@ pub struct Scratch {
 
 fn rotation() -> Mat3 {
     Mat3::from_euler(EulerRot::XYZ, 0.61, 0.93, 0.37)
+}
+
+/// A point found at squared distance `d2` (not negative), as one integer
+/// whose order is that of (d2, index): the bits of a non-negative float
+/// order like the float. Ranking by index among equal distances makes the k
+/// nearest one set whatever order the search met them in, and sorting
+/// integers is cheaper than comparing pairs.
+#[inline]
+fn found(d2: f32, index: u32) -> u64 {
+    ((d2.max(0.0).to_bits() as u64) << 32) | index as u64
+}
+
+/// The squared distance and index of a [`found`] key.
+#[inline]
+fn unpack(key: u64) -> (f32, u32) {
+    (f32::from_bits((key >> 32) as u32), key as u32)
 }
 
 /// A kd-tree over points, with the rotation applied on the way in.
@@ -62,12 +79,12 @@ impl PointTree {
     }
 
     /// Pushes (squared distance, index) of every point within sqrt(r2) of x.
-    fn within(&self, x: Vec3, r2: f32, buf: &mut Vec<(f32, u32)>) {
+    fn within(&self, x: Vec3, r2: f32, buf: &mut Vec<u64>) {
         if let Some(tree) = &self.tree {
             tree.query(&(self.rot * x).to_array())
                 .within::<SquaredEuclidean<f32>>(r2)
                 .unsorted()
-                .visit(|n| buf.push((n.distance, n.item)));
+                .visit(|n| buf.push(found(n.distance, n.item)));
         }
     }
 }
@@ -252,9 +269,9 @@ impl PhotonMap {
             if k > 0 && buf.len() >= k {
                 // Photons at equal distances (f32 squares do tie, a few
                 // times per million estimates) are ranked by index.
-                buf.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                buf.select_nth_unstable(k - 1);
                 buf.truncate(k);
-                let kth = buf[k - 1].0;
+                let kth = unpack(buf[k - 1]).0;
                 if kth <= r2 * (1.0 - 1e-4) || r2 >= r_max2 {
                     break kth;
                 }
@@ -297,8 +314,9 @@ impl PhotonMap {
         buf.terms.extend(
             buf.buf
                 .iter()
-                .filter(|&&(d2, i)| (!on_rim_excluded || d2 < g.r2) && self.faces(i, n))
-                .map(|&(_, i)| self.photons[i as usize].flux()),
+                .map(|&key| unpack(key))
+                .filter(|&(d2, i)| (!on_rim_excluded || d2 < g.r2) && self.faces(i, n))
+                .map(|(_, i)| self.photons[i as usize].flux()),
         );
         let flux = order_free_sum(&buf.terms);
         (flux / (PI * g.r2), g.r2)
@@ -317,8 +335,9 @@ impl PhotonMap {
         buf.terms.extend(
             buf.buf
                 .iter()
-                .filter(|&&(_, i)| self.faces(i, n))
-                .map(|&(d2, i)| self.photons[i as usize].flux() * (1.0 - d2.sqrt() / r).max(0.0)),
+                .map(|&key| unpack(key))
+                .filter(|&(_, i)| self.faces(i, n))
+                .map(|(d2, i)| self.photons[i as usize].flux() * (1.0 - d2.sqrt() / r).max(0.0)),
         );
         let flux = order_free_sum(&buf.terms);
         rho / PI * flux * 3.0 / (PI * g.r2)
@@ -591,7 +610,7 @@ impl IrradianceCache {
         buf.clear();
         self.tree.within(x, self.lookup_r2, buf);
         let mut best: Option<(f32, u32)> = None;
-        for &(d2, i) in buf.iter() {
+        for (d2, i) in buf.iter().map(|&key| unpack(key)) {
             if best.is_none_or(|b| d2 < b.0) && self.points[i as usize].faces(n) {
                 best = Some((d2, i));
             }
