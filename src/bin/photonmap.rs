@@ -104,9 +104,10 @@ struct Cli {
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     shadow_rays: u32,
     /// Irradiance is precomputed at every N-th stored global photon, and
-    /// final-gather rays read the nearest precomputed value.
-    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=65_536))]
-    cache_stride: u32,
+    /// final-gather rays read the nearest precomputed value [default: k / 6,
+    /// 16 at k = 100, following k down in progressive passes].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    cache_stride: Option<u32>,
     /// Samples of the light seen in pixels on the rim of a light's image
     /// (directly or in mirrors and glass; 0: no extra samples).
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(0..=1_000_000))]
@@ -239,7 +240,7 @@ fn run(cli: Cli) -> Result<(), Error> {
         gather_rays: cli.gather_rays,
         shadow_rays: cli.shadow_rays,
         edge_spp: cli.edge_spp,
-        cache_stride: cli.cache_stride as usize,
+        cache_stride: cli.cache_stride.map(|n| n as usize),
         skip: !cli.no_skip,
     };
     // Refuse before allocating: a map that cannot fit would abort the
