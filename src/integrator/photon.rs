@@ -19,7 +19,7 @@
 use super::{direct_light, glass_branches, Context, Integrator, Part};
 use crate::material::{Material, Phong};
 use crate::math::{max_component, Color, Frame, Ray};
-use crate::photon::map::{IrradianceCache, PhotonMap};
+use crate::photon::map::{CellRange, IrradianceCache, PhotonMap};
 use crate::sampling::{cosine_hemisphere, next_2d, stratified_2d};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;
@@ -206,11 +206,12 @@ impl PhotonIntegrator<'_> {
                 self.cache.prefetch_cell(slot.point);
                 g += 1;
             }
-            for h in &batch[..size] {
-                self.cache.prefetch_points(h.point);
+            let mut cells = [CellRange::default(); GATHER_BATCH];
+            for (cell, h) in cells.iter_mut().zip(&batch[..size]) {
+                *cell = self.cache.locate(h.point);
             }
-            for h in &batch[..size] {
-                sum += self.read_cache(h, ctx);
+            for (&cell, h) in cells.iter().zip(&batch[..size]) {
+                sum += self.read_cache(h, cell, ctx);
             }
         }
         // Cosine-weighted directions: f cos / pdf = (rho / pi) cos / (cos / pi) = rho.
@@ -225,14 +226,14 @@ impl PhotonIntegrator<'_> {
             return Color::ZERO;
         }
         let h = self.gather_hit(ray, dep, ctx);
-        self.read_cache(&h, ctx)
+        self.read_cache(&h, self.cache.locate(h.point), ctx)
     }
 
-    fn read_cache(&self, h: &GatherHit, ctx: &mut Context) -> Color {
+    fn read_cache(&self, h: &GatherHit, cell: CellRange, ctx: &mut Context) -> Color {
         if h.weight == Color::ZERO {
             return Color::ZERO;
         }
-        h.weight * self.cache.lookup(h.point, h.normal, ctx.scratch)
+        h.weight * self.cache.lookup_in(h.point, h.normal, cell, ctx.scratch)
     }
 
     /// Where a gather ray, followed through mirrors and glass, meets its

@@ -89,13 +89,16 @@ impl PointTree {
     }
 }
 
+/// The smallest box holding the points (min > max when there are none).
+fn bounds(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
+    points.fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(p), hi.max(p)))
+}
+
 /// Sorts photons along a Morton curve over their bounds. Keys carry the
 /// original index in their low bits, so they are unique and the order is
 /// deterministic with a fast unstable sort.
 fn morton_sort(photons: &mut Vec<Photon>) {
-    let (lo, hi) = photons.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| {
-        (lo.min(p.position()), hi.max(p.position()))
-    });
+    let (lo, hi) = bounds(photons.iter().map(Photon::position));
     let scale = 1023.0 / (hi - lo).max(Vec3::splat(f32::MIN_POSITIVE));
     let spread = |mut v: u64| {
         v &= 0x3FF;
@@ -134,9 +137,7 @@ const OCCUPANCY_MAX_CELLS: f32 = 16_777_216.0;
 
 impl Occupancy {
     fn build(photons: &[Photon], cell: f32) -> Option<Self> {
-        let (lo, hi) = photons.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| {
-            (lo.min(p.position()), hi.max(p.position()))
-        });
+        let (lo, hi) = bounds(photons.iter().map(Photon::position));
         let extent = hi - lo;
         if !(cell > 0.0) || !extent.is_finite() || !cell.is_finite() {
             return None;
@@ -430,6 +431,10 @@ struct CellIndex {
     bits: u32,
 }
 
+/// The range of a query point's cell in the cache's points, if it has one.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CellRange(Option<(u32, u32)>);
+
 #[derive(Clone, Copy)]
 struct CellSlot {
     key: u64,
@@ -526,9 +531,7 @@ impl IrradianceCache {
 
     /// Sorts the points by grid cell and indexes each cell's range.
     fn bucket(points: &mut [CachePoint], cell: f32) -> CellIndex {
-        let (lo, hi) = points.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| {
-            (lo.min(Vec3::from(p.position)), hi.max(Vec3::from(p.position)))
-        });
+        let (lo, hi) = bounds(points.iter().map(|p| Vec3::from(p.position)));
         let extent = (hi - lo).max_element();
         let fine_enough = extent / ((1u32 << CELL_BITS) - 2) as f32;
         let cell = if cell.is_finite() && cell > fine_enough { cell } else { fine_enough.max(f32::MIN_POSITIVE) };
@@ -572,20 +575,27 @@ impl IrradianceCache {
         }
     }
 
-    /// Starts fetching the points of `x`'s cell (after [`Self::prefetch_cell`]
-    /// had time to bring in the slot).
-    pub fn prefetch_points(&self, x: Vec3) {
-        if let Some((start, end)) = self.cells.range(x) {
+    /// Finds `x`'s cell (after [`Self::prefetch_cell`] had time to bring in
+    /// its slot) and starts fetching its points, for [`Self::lookup_in`].
+    pub fn locate(&self, x: Vec3) -> CellRange {
+        let range = self.cells.range(x);
+        if let Some((start, end)) = range {
             prefetch(&self.points[start as usize]);
             prefetch(&self.points[end as usize - 1]);
         }
+        CellRange(range)
     }
 
     /// Irradiance of a cached point near `x`, within the lookup radius, on
     /// a surface facing like `n`: the nearest such point in `x`'s grid cell,
     /// else the nearest anywhere; zero where no photon came near.
     pub fn lookup(&self, x: Vec3, n: Vec3, scratch: &mut Scratch) -> Color {
-        if let Some((start, end)) = self.cells.range(x) {
+        self.lookup_in(x, n, CellRange(self.cells.range(x)), scratch)
+    }
+
+    /// [`Self::lookup`] with `x`'s cell already found by [`Self::locate`].
+    pub fn lookup_in(&self, x: Vec3, n: Vec3, cell: CellRange, scratch: &mut Scratch) -> Color {
+        if let Some((start, end)) = cell.0 {
             let mut best: Option<(f32, &CachePoint)> = None;
             for p in &self.points[start as usize..end as usize] {
                 let d2 = Vec3::from(p.position).distance_squared(x);
