@@ -443,6 +443,25 @@ impl Shape {
         }
     }
 
+    /// The least and greatest value of `x . u` over the shape's points.
+    pub fn extent_along(&self, u: Vec3) -> (f32, f32) {
+        let (c, half) = match self {
+            Shape::Triangle(t) => {
+                let (a, b, c) = (t.v0.dot(u), t.v1.dot(u), t.v2.dot(u));
+                return (a.min(b).min(c), a.max(b).max(c));
+            }
+            Shape::Sphere(s) => (s.center.dot(u), s.radius * u.length()),
+            // A disk spans r |u - (u.n) n| around its centre.
+            Shape::Disk(d) => (d.center.dot(u), d.radius * (u - d.normal * u.dot(d.normal)).length()),
+            // x = M y + c over |y| = 1: c.u +- |M^T u|.
+            Shape::Ellipsoid(e) => (
+                Vec3::from(e.to_world.translation).dot(u),
+                (e.to_world.matrix3.transpose() * glam::Vec3A::from(u)).length(),
+            ),
+        };
+        (c - half, c + half)
+    }
+
     /// Axis-aligned bounds (min, max).
     pub fn bounds(&self) -> (Vec3, Vec3) {
         match self {

@@ -20,24 +20,32 @@ fn both_ways(parts: SceneParts) -> ((Film, Stats), (Film, Stats)) {
     (render(&scene, &settings(true), Mode::Quiet), render(&scene, &settings(false), Mode::Quiet))
 }
 
-/// Asserts that `a` and `b` differ by no more than two renders of the same
-/// scene with different seeds do (RMSE within 1.2x, means within 3x the
-/// seed-to-seed difference or 1%).
+/// Asserts that `a` and `b` differ by no more than renders of the same
+/// scene with other seeds do: the RMSE within 1.2x theirs, and the means
+/// within 3 standard deviations of the difference of two renders' means
+/// (estimated from four other seeds), or 1%.
+///
+/// (Until stop 10 the mean's allowance was 3x the difference to one other
+/// seed; in the noisy scene with the light facing the ceiling that one
+/// difference happened to be 0.1% while the means spread by 25% from seed to
+/// seed, and any change to the random sequences could fail the test.)
 fn same_within_noise(scene: &Scene, a: &Film, b: &Film, label: &str) {
-    let (other, _) = render(scene, &Settings { seed: 2, ..settings(false) }, Mode::Quiet);
+    let others: Vec<Film> =
+        (2..6).map(|seed| render(scene, &Settings { seed, ..settings(false) }, Mode::Quiet).0).collect();
     let diff = compare(a, b).unwrap();
-    let noise = compare(&other, b).unwrap();
-    let rel = |x: f64, y: f64| (x / y - 1.0).abs();
+    let noise = others.iter().map(|o| compare(o, b).unwrap().rmse).sum::<f64>() / others.len() as f64;
+    let means: Vec<f64> = others.iter().map(Film::mean).chain([b.mean()]).collect();
+    let mean = means.iter().sum::<f64>() / means.len() as f64;
+    let sd = (means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (means.len() - 1) as f64).sqrt();
+    let allowed = (3.0 * std::f64::consts::SQRT_2 * sd).max(0.01 * b.mean());
     eprintln!(
-        "{label}: rmse {:.5} vs seed noise {:.5}; means {:.5} {:.5} {:.5}",
+        "{label}: rmse {:.5} vs seed noise {noise:.5}; means {:.5} {:.5}, seed-to-seed sd {sd:.5}",
         diff.rmse,
-        noise.rmse,
         a.mean(),
-        b.mean(),
-        other.mean()
+        b.mean()
     );
-    assert!(diff.rmse <= 1.2 * noise.rmse, "{label}: rmse {} vs noise {}", diff.rmse, noise.rmse);
-    assert!(rel(a.mean(), b.mean()) <= (3.0 * rel(other.mean(), b.mean())).max(0.01), "{label}: means");
+    assert!(diff.rmse <= 1.2 * noise, "{label}: rmse {} vs noise {noise}", diff.rmse);
+    assert!((a.mean() - b.mean()).abs() <= allowed, "{label}: means {} {} (allowed {allowed})", a.mean(), b.mean());
 }
 
 #[test]

@@ -264,7 +264,10 @@ impl Scene {
                 Target { center, radius }
             })
             .collect();
-        let accel = Accel::new(prims.iter().map(|p| p.shape).collect());
+        // Lights stay out of the enclosure: their hits must name them.
+        let group: Vec<Option<u32>> =
+            prims.iter().zip(&light_of_prim).map(|(p, l)| l.is_none().then_some(p.material)).collect();
+        let accel = Accel::with_enclosure(prims.iter().map(|p| p.shape).collect(), &group);
         let light_cdf = lights
             .iter()
             .scan(0.0f32, |acc, l| {
