@@ -39,8 +39,14 @@ fn main() {
         dt / rays.len() as f64 * 1e9,
         rays.len() as f64 / dt / 1e6
     );
-    for (name, limit) in [("flat, watertight", usize::MAX), ("bvh, watertight", 0)] {
-        let accel = Accel::with_flat_limit(shapes.clone(), limit);
+    // The renderer's own: the room as an enclosure, a BVH over the rest.
+    let group = vec![Some(0); shapes.len()];
+    let accels = [
+        ("flat, watertight", Accel::with_flat_limit(shapes.clone(), usize::MAX)),
+        ("bvh, watertight", Accel::with_flat_limit(shapes.clone(), 0)),
+        ("enclosure + bvh (the renderer's)", Accel::with_enclosure(shapes.clone(), &group)),
+    ];
+    for (name, accel) in accels {
         let t = Instant::now();
         let hits = rays.iter().filter(|r| accel.closest_hit(r, None, f32::INFINITY).is_some()).count();
         let dt = t.elapsed().as_secs_f64();
@@ -70,10 +76,11 @@ fn mesh_scene() {
     let t = Instant::now();
     let bvh = Accel::new(shapes.clone());
     println!("BVH build (binned SAH, serial): {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
+    let enclosed = Accel::with_enclosure(shapes.clone(), &vec![Some(0); shapes.len()]);
     let flat = Accel::with_flat_limit(shapes, usize::MAX);
     for (kind, rays) in [("camera", &camera_rays), ("random", &random)] {
         let mut rates = Vec::new();
-        for (name, accel, n) in [("bvh", &bvh, rays.len()), ("flat", &flat, 2_000)] {
+        for (name, accel, n) in [("bvh", &bvh, rays.len()), ("flat", &flat, 2_000), ("enclosure + bvh", &enclosed, rays.len())] {
             let t = Instant::now();
             let hits = rays[..n].iter().filter(|r| accel.closest_hit(r, None, f32::INFINITY).is_some()).count();
             let dt = t.elapsed().as_secs_f64();
