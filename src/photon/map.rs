@@ -33,34 +33,7 @@ pub struct Scratch {
     /// The terms of an estimate's sum.
     terms: Vec<Color>,
     hint_r2: f32,
-    /// Every photon of a ball around a recent caustic query (see
-    /// [`PhotonMap::gather_coherent`]).
-    near: Near,
-    /// Estimates answered from `near` without a search (diagnostics, tests).
-    pub reused: u64,
 }
-
-/// All the photons of one map inside a ball.
-#[derive(Default, Debug)]
-struct Near {
-    /// Which map ([`PhotonMap::id`]); 0: none yet.
-    map: u64,
-    /// Centre, in the tree's rotated frame, and the squared radius within
-    /// which every photon of the map is among `indices`.
-    centre: Vec3,
-    complete_r2: f32,
-    indices: Vec<u32>,
-}
-
-/// Distinguishes maps, so that a scratch used with two maps never answers
-/// one's query with the other's photons.
-static NEXT_MAP_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
-
-/// A caustic search reaches this fraction of the radius cap beyond what
-/// the query needs, so that the next queries nearby (the pixel's other
-/// samples; at 800 x 800 a pixel spans about 0.06 of the cap on the floor)
-/// find their photons among those found (see [`PhotonMap::gather_coherent`]).
-const NEAR_MARGIN: f32 = 0.1;
 
 fn rotation() -> Mat3 {
     Mat3::from_euler(EulerRot::XYZ, 0.61, 0.93, 0.37)
@@ -105,16 +78,10 @@ impl PointTree {
         })
     }
 
-    /// A point in the tree's rotated frame.
-    fn rotated(&self, x: Vec3) -> Vec3 {
-        self.rot * x
-    }
-
-    /// Pushes (squared distance, index) of every point within sqrt(r2) of
-    /// `xr`, given in the rotated frame ([`PointTree::rotated`]).
-    fn within(&self, xr: Vec3, r2: f32, buf: &mut Vec<u64>) {
+    /// Pushes (squared distance, index) of every point within sqrt(r2) of x.
+    fn within(&self, x: Vec3, r2: f32, buf: &mut Vec<u64>) {
         if let Some(tree) = &self.tree {
-            tree.query(&xr.to_array())
+            tree.query(&(self.rot * x).to_array())
                 .within::<SquaredEuclidean<f32>>(r2)
                 .unsorted()
                 .visit(|n| buf.push(found(n.distance, n.item)));
@@ -223,8 +190,6 @@ impl Occupancy {
 pub struct PhotonMap {
     photons: Vec<Photon>,
     tree: PointTree,
-    /// Unique per map (see [`Near`]).
-    id: u64,
     /// Consulted before the tree, when built ([`PhotonMap::with_occupancy`]).
     occupancy: Option<Occupancy>,
 }
@@ -240,8 +205,7 @@ impl PhotonMap {
     pub fn build(mut photons: Vec<Photon>) -> Self {
         morton_sort(&mut photons);
         let tree = PointTree::build(photons.par_iter().map(|p| p.position()));
-        let id = NEXT_MAP_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        PhotonMap { photons, tree, id, occupancy: None }
+        PhotonMap { photons, tree, occupancy: None }
     }
 
     /// The same map with an occupancy grid for lookups with radius caps up
@@ -300,10 +264,9 @@ impl PhotonMap {
         // wider, in case the tree's pruning, which rounds, kept or dropped a
         // photon at the rim depending on the radius asked.
         let mut r2 = if k > 0 && scratch.hint_r2 > 0.0 { scratch.hint_r2.min(r_max2) } else { r_max2 };
-        let xr = self.tree.rotated(x);
         let r2 = loop {
             buf.clear();
-            self.tree.within(xr, r2, buf);
+            self.tree.within(x, r2, buf);
             if k > 0 && buf.len() >= k {
                 // Photons at equal distances (f32 squares do tie, a few
                 // times per million estimates) are ranked by index.
@@ -329,92 +292,6 @@ impl PhotonMap {
         // hence on which thread ran the previous query: the estimates sum
         // with `order_free_sum`, whose result does not depend on the order.
         Gathered { r2, count: buf.len() }
-    }
-
-    /// What [`PhotonMap::gather`] finds, with every photon's distance
-    /// computed exactly as the tree computes it (so the same photons, ranked
-    /// the same way), but for queries that come in runs close together:
-    /// each search reaches [`NEAR_MARGIN`] of the cap further than needed
-    /// and keeps all it found, and a query whose k nearest photons (or,
-    /// where fewer than k lie within the cap, whose whole disk) fall inside
-    /// that ball selects them there instead of searching. Within the cap it
-    /// is also exact at the rim (the search goes beyond it), where
-    /// [`PhotonMap::gather`] takes what the tree's rounding gives.
-    fn gather_coherent(&self, x: Vec3, k: usize, r_max: f32, scratch: &mut Scratch) -> Gathered {
-        let r_max2 = r_max * r_max;
-        if self.certainly_empty(x, r_max) {
-            scratch.buf.clear();
-            scratch.hint_r2 = r_max2;
-            return Gathered { r2: r_max2, count: 0 };
-        }
-        let xr = self.tree.rotated(x);
-        if let Some(g) = self.reuse(xr, k.max(1), r_max, scratch) {
-            scratch.reused += 1;
-            return g;
-        }
-        let k = k.max(1);
-        let margin = NEAR_MARGIN * r_max;
-        // The radius the query needs, first guessed from the last query's.
-        let mut r = if scratch.hint_r2 > 0.0 { scratch.hint_r2.sqrt().min(r_max) } else { r_max };
-        loop {
-            let search2 = (r + margin) * (r + margin);
-            let buf = &mut scratch.buf;
-            buf.clear();
-            self.tree.within(xr, search2, buf);
-            // The tree's pruning rounds: a photon within 1e-4 of the rim may
-            // be missing, none inside.
-            let complete2 = search2 * (1.0 - 1e-4);
-            let near = &mut scratch.near;
-            near.indices.clear();
-            near.indices.extend(buf.iter().map(|&key| unpack(key).1));
-            (near.map, near.centre, near.complete_r2) = (self.id, xr, complete2);
-            if let Some(g) = select(buf, k, r_max2, complete2) {
-                scratch.hint_r2 = if g.r2 < r_max2 { g.r2 * 1.25 } else { r_max2 };
-                return g;
-            }
-            // Too few found: grow as `gather` does (count ~ r^2).
-            let grow = (1.3 * k as f32 / buf.len().max(1) as f32).clamp(1.5, 4.0);
-            r = (r * grow.sqrt()).min(r_max);
-        }
-    }
-
-    /// The query at `xr` (rotated frame) answered from the photons kept
-    /// from a recent search, when that ball provably holds everything the
-    /// query needs; `None` otherwise.
-    fn reuse(&self, xr: Vec3, k: usize, r_max: f32, s: &mut Scratch) -> Option<Gathered> {
-        let near = &s.near;
-        if near.map != self.id {
-            return None;
-        }
-        let offset = (xr - near.centre).length();
-        // Everything within `inner` of the query is in the ball (margins
-        // for the rounding of these sums).
-        let inner2 = {
-            let room = near.complete_r2.sqrt() * (1.0 - 1e-5) - offset * (1.0 + 1e-5);
-            if !(room > 0.0) {
-                return None;
-            }
-            room * room * (1.0 - 1e-5)
-        };
-        // Skip the scan where the last query's radius would not fit.
-        if !(s.hint_r2.min(r_max * r_max) / 1.25 < inner2) {
-            return None;
-        }
-        let buf = &mut s.buf;
-        buf.clear();
-        buf.extend(near.indices.iter().map(|&i| {
-            let d = xr - self.tree.rotated(self.photons[i as usize].position());
-            // The tree's squared distance: axis terms added in order from 0.
-            let mut d2 = 0.0f32;
-            d2 += d.x * d.x;
-            d2 += d.y * d.y;
-            d2 += d.z * d.z;
-            found(d2, i)
-        }));
-        let r_max2 = r_max * r_max;
-        let g = select(buf, k, r_max2, inner2)?;
-        s.hint_r2 = if g.r2 < r_max2 { g.r2 * 1.25 } else { r_max2 };
-        Some(g)
     }
 
     /// Whether photon `i` lies on a surface facing like `n` (photons on
@@ -450,7 +327,7 @@ impl PhotonMap {
     /// estimated with Jensen's cone filter (k = 1: weight 1 - d / r,
     /// normalised by 1 / (1 - 2/3)), which keeps caustic edges sharp.
     pub fn radiance_cone(&self, x: Vec3, n: Vec3, rho: Color, k: usize, r_max: f32, buf: &mut Scratch) -> Color {
-        let g = self.gather_coherent(x, k, r_max, buf);
+        let g = self.gather(x, k, r_max, buf);
         if g.count == 0 || !(g.r2 > 0.0) {
             return Color::ZERO;
         }
@@ -466,29 +343,6 @@ impl PhotonMap {
         let flux = order_free_sum(&buf.terms);
         rho / PI * flux * 3.0 / (PI * g.r2)
     }
-}
-
-/// From `buf`, every photon within `complete2` of a query (and perhaps
-/// some beyond), the query's photons: the k nearest by (distance, index)
-/// when the k-th lies within the cap, else all within the cap. `None` when
-/// `complete2` does not reach far enough to know. Leaves them in `buf`.
-fn select(buf: &mut Vec<u64>, k: usize, r_max2: f32, complete2: f32) -> Option<Gathered> {
-    if buf.len() >= k {
-        buf.select_nth_unstable(k - 1);
-        let kth = unpack(buf[k - 1]).0;
-        if kth <= r_max2 && kth <= complete2 {
-            buf.truncate(k);
-            return Some(Gathered { r2: kth, count: k });
-        }
-    }
-    // Fewer than k within the cap, if the ball covers the cap's disk.
-    if complete2 >= r_max2 {
-        buf.retain(|&key| unpack(key).0 <= r_max2);
-        if buf.len() < k {
-            return Some(Gathered { r2: r_max2, count: buf.len() });
-        }
-    }
-    None
 }
 
 /// The sum of non-negative, finite colours, the same whatever their order
@@ -764,7 +618,7 @@ impl IrradianceCache {
         }
         let buf = &mut scratch.buf;
         buf.clear();
-        self.tree.within(self.tree.rotated(x), self.lookup_r2, buf);
+        self.tree.within(x, self.lookup_r2, buf);
         let mut best: Option<(f32, u32)> = None;
         for (d2, i) in buf.iter().map(|&key| unpack(key)) {
             if best.is_none_or(|b| d2 < b.0) && self.points[i as usize].faces(n) {
@@ -882,9 +736,6 @@ mod tests {
         backward.reverse();
         assert_eq!(forward, fresh);
         assert_eq!(backward, fresh);
-        // The cone estimates along the path came from the photons kept by
-        // the previous search (`gather_coherent`), and gave the same bits.
-        assert!(s.reused > 50, "{} reused", s.reused);
         // Some estimates found fewer than k within the cap, some more.
         assert!(fresh.iter().any(|f| f.2 < 0.1 * 0.1) && fresh.iter().any(|f| f.2 == 0.1f32 * 0.1));
     }
