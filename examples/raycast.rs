@@ -80,7 +80,9 @@ fn mesh_scene() {
     let flat = Accel::with_flat_limit(shapes, usize::MAX);
     for (kind, rays) in [("camera", &camera_rays), ("random", &random)] {
         let mut rates = Vec::new();
-        for (name, accel, n) in [("bvh", &bvh, rays.len()), ("flat", &flat, 2_000), ("enclosure + bvh", &enclosed, rays.len())] {
+        for (name, accel, n) in
+            [("bvh", &bvh, rays.len()), ("flat", &flat, 2_000), ("enclosure + bvh", &enclosed, rays.len())]
+        {
             let t = Instant::now();
             let hits = rays[..n].iter().filter(|r| accel.closest_hit(r, None, f32::INFINITY).is_some()).count();
             let dt = t.elapsed().as_secs_f64();
