@@ -38,7 +38,10 @@ struct Face {
     n: Vec3,
     d: f32,
     /// The primitive a hit on this face reports (the lowest index of its
-    /// tiling; all share a material), and that triangle's own normal.
+    /// tiling; all share a material and none is a light), and that
+    /// triangle's own normal. Which triangle of the face was hit is not
+    /// tracked: nothing downstream depends on it (a per-triangle attribute,
+    /// a texture, would need a 2D lookup here).
     prim: u32,
     normal: Vec3,
 }
