@@ -186,14 +186,14 @@ impl Enclosure {
         self.face_of.get(prim as usize).is_some_and(|&f| f != NONE)
     }
 
-    /// The face primitive `prim` tiles, or [`NONE`].
+    /// The face primitive `prim` tiles, or `u32::MAX`.
     pub fn face_of(&self, prim: u32) -> u32 {
         self.face_of.get(prim as usize).copied().unwrap_or(NONE)
     }
 
     /// Where the ray meets the enclosure in (0, t_max): leaving it from
     /// inside, or entering it from outside. `skip` is the face the ray
-    /// leaves ([`NONE`] if none): a ray never meets a plane it leaves again.
+    /// leaves (`u32::MAX` if none): a ray never meets a plane it leaves again.
     #[inline]
     pub fn hit(&self, ray: &Ray, skip: u32, t_max: f32) -> Option<EnclosureHit> {
         let (ox, oy, oz) = (Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z));
