@@ -116,7 +116,11 @@ impl Accel {
         let wall = self.enclosure_hit(ray, departure, t_max);
         let mut best: Option<(&Shape, u32, f32, [f32; 2])> = None;
         let rs = RayShear::new(ray);
-        self.traverse(ray, wall.map_or(t_max, |w| w.t), |shape, index, t_limit| {
+        // A primitive lying on a face (a rug on the floor, a light set in the
+        // ceiling) wins the tie with it: the search reaches the wall's
+        // distance plus its rounding, and nothing lies behind a face.
+        let limit = wall.map_or(t_max, |w| (w.t * (1.0 + crate::math::gamma(8))).min(t_max));
+        self.traverse(ray, limit, |shape, index, t_limit| {
             let departed = departure.filter(|d| d.prim == index).map(|d| d.outward);
             if let Some((t, uv)) = shape.distance(ray, &rs, *t_limit, departed) {
                 *t_limit = t;
@@ -450,6 +454,35 @@ mod tests {
         }
         assert!(checked > 190_000);
         assert!(outside < 2_000, "{outside} rays hit only the polyhedron");
+    }
+
+    /// A triangle lying on a face of the enclosure (a rug on the floor)
+    /// is what rays see there, not the face under it.
+    #[test]
+    fn a_rug_on_the_floor_wins_over_the_floor() {
+        use crate::scene::{Eye, Scene};
+        let parts = Scene::tncg15_parts(Eye::One);
+        let mut shapes: Vec<Shape> = parts.prims.iter().map(|p| p.shape).collect();
+        let mut group: Vec<Option<u32>> = parts.prims.iter().map(|p| Some(p.material)).collect();
+        let z = -5.0;
+        for (a, b, c) in [((2.0, -2.0), (6.0, -2.0), (6.0, 2.0)), ((2.0, -2.0), (6.0, 2.0), (2.0, 2.0))] {
+            let v = |(x, y): (f32, f32)| glam::Vec3::new(x, y, z);
+            shapes.push(Shape::Triangle(Triangle::new(v(a), v(b), v(c))));
+            group.push(Some(99));
+        }
+        let rug = [shapes.len() as u32 - 2, shapes.len() as u32 - 1];
+        let accel = Accel::with_enclosure(shapes, &group);
+        assert_eq!(accel.enclosure().map(|e| e.faces()), Some(8), "the rug does not break the room");
+        let mut rng = stream(4, Domain::Camera, 0);
+        for _ in 0..20_000 {
+            let u = next_2d(&mut rng);
+            let target = glam::Vec3::new(2.05 + 3.9 * u.x, -1.95 + 3.9 * u.y, z);
+            let w = next_2d(&mut rng);
+            let origin = glam::Vec3::new(-1.0 + 10.0 * w.x, -4.0 + 8.0 * w.y, 4.0);
+            let ray = Ray::new(origin, (target - origin).normalize());
+            let hit = accel.closest_hit(&ray, None, f32::INFINITY).map(|h| h.0);
+            assert!(hit.is_some_and(|p| rug.contains(&p)), "{ray:?} -> {hit:?}");
+        }
     }
 
     /// The hierarchy must find exactly what testing every shape finds.
