@@ -183,7 +183,7 @@ impl Enclosure {
 
     /// Whether primitive `prim` is part of the enclosure (and not in the BVH).
     pub fn contains(&self, prim: u32) -> bool {
-        self.face_of.get(prim as usize).is_some_and(|&f| f != NONE)
+        self.face_of(prim) != NONE
     }
 
     /// The face primitive `prim` tiles, or `u32::MAX`.

@@ -111,16 +111,20 @@ impl Accel {
         e.hit(ray, skip, t_max)
     }
 
+    /// How far the search among the objects inside reaches: to the wall,
+    /// plus its rounding, so that a primitive lying on a face (a rug on the
+    /// floor, a light set in the ceiling) wins the tie with it; nothing lies
+    /// behind a face.
+    fn inside_limit(wall: Option<enclosure::EnclosureHit>, t_max: f32) -> f32 {
+        wall.map_or(t_max, |w| (w.t * (1.0 + crate::math::gamma(8))).min(t_max))
+    }
+
     /// Nearest hit in (0, t_max) and the index of the primitive hit.
     pub fn closest_hit(&self, ray: &Ray, departure: Option<Departure>, t_max: f32) -> Option<(u32, ShapeHit)> {
         let wall = self.enclosure_hit(ray, departure, t_max);
         let mut best: Option<(&Shape, u32, f32, [f32; 2])> = None;
         let rs = RayShear::new(ray);
-        // A primitive lying on a face (a rug on the floor, a light set in the
-        // ceiling) wins the tie with it: the search reaches the wall's
-        // distance plus its rounding, and nothing lies behind a face.
-        let limit = wall.map_or(t_max, |w| (w.t * (1.0 + crate::math::gamma(8))).min(t_max));
-        self.traverse(ray, limit, |shape, index, t_limit| {
+        self.traverse(ray, Self::inside_limit(wall, t_max), |shape, index, t_limit| {
             let departed = departure.filter(|d| d.prim == index).map(|d| d.outward);
             if let Some((t, uv)) = shape.distance(ray, &rs, *t_limit, departed) {
                 *t_limit = t;
@@ -141,7 +145,7 @@ impl Accel {
         let mut n = 0;
         let rs = RayShear::new(ray);
         let wall = self.enclosure_hit(ray, None, f32::INFINITY);
-        self.traverse(ray, wall.map_or(f32::INFINITY, |w| w.t), |shape, _, t_limit| {
+        self.traverse(ray, Self::inside_limit(wall, f32::INFINITY), |shape, _, t_limit| {
             n += 1;
             if let Some((t, _)) = shape.distance(ray, &rs, *t_limit, None) {
                 *t_limit = t;
