@@ -144,7 +144,10 @@ pub struct Stats {
     pub edge_pixels: usize,
     pub first_nonfinite: Option<(u64, &'static str)>,
     pub photon_time: Duration,
-    pub build_time: Duration,
+    /// The map build: kd-trees (Morton sort, trees, occupancy grid), then
+    /// the irradiance cache (estimates at photons, their grid and tree).
+    pub tree_time: Duration,
+    pub cache_time: Duration,
     pub camera_time: Duration,
     /// Radius caps and photons per estimate (of the last pass when progressive).
     pub r_global: f32,
@@ -161,6 +164,10 @@ pub struct Stats {
 }
 
 impl Stats {
+    pub fn build_time(&self) -> Duration {
+        self.tree_time + self.cache_time
+    }
+
     /// Adds another pass's counts and times (maps' sizes are the last pass's).
     fn absorb(&mut self, o: Stats) {
         self.global_emitted += o.global_emitted;
@@ -172,7 +179,8 @@ impl Stats {
         self.nonfinite += o.nonfinite;
         self.first_nonfinite = self.first_nonfinite.or(o.first_nonfinite);
         self.photon_time += o.photon_time;
-        self.build_time += o.build_time;
+        self.tree_time += o.tree_time;
+        self.cache_time += o.cache_time;
         self.camera_time += o.camera_time;
         self.global_stored = o.global_stored;
         self.caustic_stored = o.caustic_stored;
@@ -260,8 +268,12 @@ fn photon_pass(
     };
     let t = Instant::now();
     let phase = Phase::start(progress, "photon pass", settings.photons + settings.caustic_photons);
-    let global = trace_pass(scene, Pass::Global, settings.photons, seed, &|n| phase.advance(n));
-    let caustic = trace_pass(scene, Pass::Caustic, settings.caustic_photons, seed, &|n| phase.advance(n));
+    // Both passes at once: the threads that finish one pass's last blocks
+    // early take the other's instead of waiting.
+    let (global, caustic) = rayon::join(
+        || trace_pass(scene, Pass::Global, settings.photons, seed, &|n| phase.advance(n)),
+        || trace_pass(scene, Pass::Caustic, settings.caustic_photons, seed, &|n| phase.advance(n)),
+    );
     phase.finish();
     stats.photon_time += t.elapsed();
     stats.global_emitted += global.emitted;
@@ -272,12 +284,17 @@ fn photon_pass(
 
     let t = Instant::now();
     // Caustic lookups may meet empty regions of the map; global-map
-    // lookups run at photons (the irradiance cache) and need no grid.
-    let global_map = PhotonMap::build(global.photons);
-    let caustic_map = PhotonMap::build(caustic.photons).with_occupancy(settings.skip.then_some(est.r_caustic));
+    // lookups run at photons (the irradiance cache) and need no grid. The
+    // two builds at once: each has serial stretches the other can fill.
+    let (global_map, caustic_map) = rayon::join(
+        || PhotonMap::build(global.photons),
+        || PhotonMap::build(caustic.photons).with_occupancy(settings.skip.then_some(est.r_caustic)),
+    );
+    stats.tree_time += t.elapsed();
+    let t = Instant::now();
     let stride = settings.cache_stride.unwrap_or_else(|| cache_stride(est.k_global));
     let cache = IrradianceCache::build(&global_map, stride, est.k_global, est.r_global);
-    stats.build_time += t.elapsed();
+    stats.cache_time += t.elapsed();
     stats.global_stored = global_map.len();
     stats.caustic_stored = caustic_map.len();
     stats.cache_points = cache.len();

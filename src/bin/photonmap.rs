@@ -428,7 +428,12 @@ fn summary(s: &Stats, settings: &Settings, write_time: std::time::Duration, tota
         (s.global_emitted + s.caustic_emitted) as f64 / s.photon_time.as_secs_f64().max(1e-9) / 1e6,
         mrays(s.photon_rays, s.photon_time)
     );
-    eprintln!("  map build    {:>8.3} s  (kd-trees + irradiance cache)", s.build_time.as_secs_f64());
+    eprintln!(
+        "  map build    {:>8.3} s  (kd-trees {:.3} s, irradiance cache {:.3} s)",
+        s.build_time().as_secs_f64(),
+        s.tree_time.as_secs_f64(),
+        s.cache_time.as_secs_f64()
+    );
     eprintln!(
         "  camera pass  {:>8.3} s  {:>7.2} M rays/s  ({} x {}, {} spp, {} gather rays, {} shadow rays)",
         s.camera_time.as_secs_f64(),

@@ -7,7 +7,7 @@
 //! distances are unchanged by a rotation. Photons are stored in Morton order
 //! so that neighbours in space are neighbours in memory.
 
-use super::{quantize_normal, Photon};
+use super::{quantize_normal, Photon, PhotonBlocks};
 use crate::math::Color;
 use glam::{EulerRot, Mat3, Vec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
@@ -94,11 +94,19 @@ fn bounds(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
     points.fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(p), hi.max(p)))
 }
 
-/// Sorts photons along a Morton curve over their bounds. Keys carry the
-/// original index in their low bits, so they are unique and the order is
-/// deterministic with a fast unstable sort.
-fn morton_sort(photons: &mut Vec<Photon>) {
-    let (lo, hi) = bounds(photons.iter().map(Photon::position));
+/// How many photons ahead the Morton gather prefetches.
+const GATHER_AHEAD: usize = 8;
+
+/// The photons along a Morton curve over their bounds, read from their
+/// blocks. Keys carry the photon's index in their low bits, so they are
+/// unique and the order is deterministic with a fast unstable sort.
+fn morton_sorted(photons: &PhotonBlocks) -> Vec<Photon> {
+    let empty = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+    let (lo, hi) = photons
+        .blocks()
+        .par_iter()
+        .map(|b| bounds(b.iter().map(Photon::position)))
+        .reduce(|| empty, |a, b| (a.0.min(b.0), a.1.max(b.1)));
     let scale = 1023.0 / (hi - lo).max(Vec3::splat(f32::MIN_POSITIVE));
     let spread = |mut v: u64| {
         v &= 0x3FF;
@@ -107,17 +115,28 @@ fn morton_sort(photons: &mut Vec<Photon>) {
         v = (v | (v << 4)) & 0x030C_30C3;
         (v | (v << 2)) & 0x0924_9249
     };
-    let mut keys: Vec<u64> = photons
-        .par_iter()
-        .enumerate()
-        .map(|(i, p)| {
+    let mut keys = vec![0u64; photons.len()];
+    photons.split_like(&mut keys).into_par_iter().enumerate().for_each(|(b, keys)| {
+        let start = photons.start(b);
+        for (i, (key, p)) in keys.iter_mut().zip(&photons.blocks()[b]).enumerate() {
             let q = ((p.position() - lo) * scale).as_uvec3();
             let code = spread(q.x as u64) | (spread(q.y as u64) << 1) | (spread(q.z as u64) << 2);
-            (code << 32) | i as u64
-        })
-        .collect();
+            *key = (code << 32) | (start + i) as u64;
+        }
+    });
     keys.par_sort_unstable();
-    *photons = keys.par_iter().map(|k| photons[(k & 0xFFFF_FFFF) as usize]).collect();
+    // Photons are read in random order: prefetching a few ahead keeps
+    // several reads in flight (the gather took 1.6x as long without).
+    let index = |k: u64| (k & 0xFFFF_FFFF) as usize;
+    keys.par_iter()
+        .enumerate()
+        .map(|(r, &k)| {
+            if let Some(&ahead) = keys.get(r + GATHER_AHEAD) {
+                prefetch(photons.get(index(ahead)));
+            }
+            *photons.get(index(k))
+        })
+        .collect()
 }
 
 /// A bitmap over the map's bounds of the cells that hold a photon, with
@@ -202,8 +221,9 @@ pub struct Gathered {
 }
 
 impl PhotonMap {
-    pub fn build(mut photons: Vec<Photon>) -> Self {
-        morton_sort(&mut photons);
+    /// A map of `photons` (a pass's blocks, or one vector).
+    pub fn build(photons: impl Into<PhotonBlocks>) -> Self {
+        let photons = morton_sorted(&photons.into());
         let tree = PointTree::build(photons.par_iter().map(|p| p.position()));
         PhotonMap { photons, tree, occupancy: None }
     }

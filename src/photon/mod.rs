@@ -9,8 +9,11 @@
 //!   estimate is unchanged) and stores only the paths light → specular+ →
 //!   diffuse: the caustic map, read directly at visible surfaces.
 
+mod blocks;
 pub mod map;
 pub mod trace;
+
+pub use blocks::PhotonBlocks;
 
 use crate::math::Color;
 use glam::Vec3;

@@ -2,11 +2,10 @@
 //! surfaces, continue by Russian roulette.
 //!
 //! Every photon draws from its own random stream keyed by (seed, pass,
-//! photon index), and photons are traced in fixed-size blocks whose results
-//! are concatenated in block order, so the maps are identical whatever the
-//! number of threads.
+//! photon index), and photons are traced in fixed-size blocks kept in block
+//! order, so the maps are identical whatever the number of threads.
 
-use super::Photon;
+use super::{Photon, PhotonBlocks};
 use crate::light::Light;
 use crate::material::{Lobe, Material};
 use crate::math::{max_component, Color, Frame, Ray};
@@ -39,7 +38,7 @@ pub enum Pass {
 /// The photons of one pass and what it cost.
 #[derive(Debug, Default)]
 pub struct PassOutput {
-    pub photons: Vec<Photon>,
+    pub photons: PhotonBlocks,
     pub emitted: u64,
     /// Rays cast (one per segment of every photon path).
     pub rays: u64,
@@ -66,11 +65,12 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
     };
     let per_block: Vec<Vec<Photon>> = (0..blocks)
         .into_par_iter()
-        // Each thread traces into one buffer it keeps (a global block stores
-        // ~5 photons per emitted one; a fresh vector per block grew, copied
-        // and faulted its way there) and hands out an exact-size copy.
+        // Each thread traces into a buffer that has reached the size of its
+        // blocks (a fresh vector per block grew, copied and faulted its way
+        // to ~20,000 photons) and hands the buffer itself out, not a copy;
+        // the next block starts in a fresh one of that capacity, whose pages
+        // are faulted in only as photons are written.
         .map_init(Vec::new, |out: &mut Vec<Photon>, b| {
-            out.clear();
             let mut block_rays = 0;
             let mut block_first = 0;
             for i in b * BLOCK..((b + 1) * BLOCK).min(n) {
@@ -85,39 +85,16 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
             rays.fetch_add(block_rays, Ordering::Relaxed);
             first_specular.fetch_add(block_first, Ordering::Relaxed);
             on_block(((b + 1) * BLOCK).min(n) - b * BLOCK);
-            out.clone()
+            let capacity = out.capacity();
+            std::mem::replace(out, Vec::with_capacity(capacity))
         })
         .collect();
     PassOutput {
-        photons: concat_parallel(per_block),
+        photons: PhotonBlocks::new(per_block),
         emitted: n,
         rays: rays.into_inner(),
         first_hit_specular: first_specular.into_inner(),
     }
-}
-
-/// The blocks' photons in block order, copied by all threads: a serial
-/// `concat` of the default pass's 160 MB (and the page faults of its fresh
-/// memory) took a tenth of the pass on one core.
-fn concat_parallel(blocks: Vec<Vec<Photon>>) -> Vec<Photon> {
-    let total = blocks.iter().map(Vec::len).sum();
-    let mut photons: Vec<Photon> = Vec::with_capacity(total);
-    let mut rest = &mut photons.spare_capacity_mut()[..total];
-    let mut parts = Vec::with_capacity(blocks.len());
-    for b in &blocks {
-        let (head, tail) = rest.split_at_mut(b.len());
-        parts.push(head);
-        rest = tail;
-    }
-    parts.into_par_iter().zip(blocks.par_iter()).for_each(|(dst, src)| {
-        for (d, s) in dst.iter_mut().zip(src) {
-            d.write(*s);
-        }
-    });
-    // SAFETY: the parts tile the first `total` slots, and each slot was
-    // written above from its block.
-    unsafe { photons.set_len(total) };
-    photons
 }
 
 /// Picks a light in proportion to its power (one light: always it) and
