@@ -81,18 +81,57 @@ pub fn offset_ray_origin(p: Vertex, p_err: Vec3, n: Vec3, dir: Direction) -> Ver
     if dir.dot(n) < 0.0 {
         offset = -offset;
     }
-    let mut po = p + offset;
-    for i in 0..3 {
-        if offset[i] > 0.0 {
-            po[i] = po[i].next_up();
-        } else if offset[i] < 0.0 {
-            po[i] = po[i].next_down();
-        }
-    }
-    po
+    let po = p + offset;
+    Vec3::new(nudge(po.x, offset.x), nudge(po.y, offset.y), nudge(po.z, offset.z))
+}
+
+/// `x.next_up()` where `towards > 0`, `x.next_down()` where `towards < 0`,
+/// else `x`, for finite `x`, without branches: the offset's signs are
+/// random from ray to ray, and the library functions' branches were
+/// mispredicted often enough to cost 7% of the photon pass.
+#[inline]
+fn nudge(x: f32, towards: f32) -> f32 {
+    let bits = x.to_bits();
+    let up = (towards > 0.0) as u32;
+    let moves = 0u32.wrapping_sub(up | (towards < 0.0) as u32);
+    // A step up from a positive number, or down from a negative one, grows
+    // the magnitude: one more in the bits; otherwise one less. Zero steps
+    // to the smallest subnormal of the step's sign. Selected with masks:
+    // written as branches, the compiler kept them.
+    let grows = up ^ (bits >> 31);
+    let stepped = bits.wrapping_add((grows << 1).wrapping_sub(1));
+    let zero = 0u32.wrapping_sub((bits & 0x7FFF_FFFF == 0) as u32);
+    let from_zero = 1 | ((1 - up) << 31);
+    let next = (stepped & !zero) | (from_zero & zero);
+    f32::from_bits((next & moves) | (bits & !moves))
 }
 
 /// Largest component, used for Russian roulette on RGB weights.
 pub fn max_component(c: Color) -> f32 {
     c.x.max(c.y).max(c.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nudge_steps_like_next_up_and_next_down() {
+        let mut xs = vec![0.0f32, -0.0, 1.0, -1.0, f32::MIN_POSITIVE, -f32::MIN_POSITIVE, f32::MAX, f32::MIN];
+        xs.extend([f32::from_bits(1), f32::from_bits(0x8000_0001), 1e-40, -1e-40, 3.0, -2.5e7]);
+        // Finite floats of every exponent, from a fixed sequence of bits.
+        let mut bits = 0x1234_5678u32;
+        for _ in 0..200_000 {
+            bits = bits.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            let x = f32::from_bits(bits);
+            if x.is_finite() {
+                xs.push(x);
+            }
+        }
+        for x in xs {
+            for (towards, want) in [(1.0, x.next_up()), (-1.0, x.next_down()), (0.0, x), (-0.0, x), (f32::NAN, x)] {
+                assert_eq!(nudge(x, towards).to_bits(), want.to_bits(), "{x:e} towards {towards}");
+            }
+        }
+    }
 }
