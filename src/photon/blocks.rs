@@ -8,7 +8,6 @@
 //! vector, and everything keyed by it stays thread-count independent.
 
 use super::Photon;
-use rayon::prelude::*;
 
 /// Photons per entry of [`PhotonBlocks::locate`]'s table: fewer than a
 /// block of the pass holds (4096 emitted, ~1 to ~5 stored each).
@@ -94,15 +93,6 @@ impl PhotonBlocks {
         }
         parts
     }
-
-    /// The photons in one vector (tests and benches; the renderer never
-    /// joins them).
-    pub fn into_vec(self) -> Vec<Photon> {
-        let mut out = vec![Photon::default(); self.len()];
-        let parts = self.split_like(&mut out);
-        parts.into_par_iter().zip(self.blocks.par_iter()).for_each(|(d, s)| d.copy_from_slice(s));
-        out
-    }
 }
 
 impl From<Vec<Photon>> for PhotonBlocks {
@@ -145,9 +135,14 @@ mod tests {
         for i in 0..next {
             assert_eq!(photons.get(i).pos[0], i as f32, "photon {i}");
         }
-        let flat = photons.clone().into_vec();
+        let flat: Vec<Photon> = photons.iter().copied().collect();
         assert!(flat.iter().enumerate().all(|(i, p)| p.pos[0] == i as f32));
         assert_eq!(photons, PhotonBlocks::from(flat));
+        let mut keys = vec![0; next];
+        for (b, part) in photons.split_like(&mut keys).into_iter().enumerate() {
+            part.iter_mut().enumerate().for_each(|(j, k)| *k = photons.start(b) + j);
+        }
+        assert!(keys.iter().enumerate().all(|(i, &k)| k == i));
         assert!(PhotonBlocks::new(vec![vec![], vec![]]).is_empty());
         assert!(PhotonBlocks::default().is_empty());
     }

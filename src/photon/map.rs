@@ -109,12 +109,11 @@ const GATHER_AHEAD: usize = 8;
 /// blocks. Keys carry the photon's index in their low bits, so they are
 /// unique and the order is deterministic with a fast unstable sort.
 fn morton_sorted(photons: &PhotonBlocks) -> Vec<Photon> {
-    let empty = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
     let (lo, hi) = photons
         .blocks()
         .par_iter()
         .map(|b| bounds(b.iter().map(Photon::position)))
-        .reduce(|| empty, |a, b| (a.0.min(b.0), a.1.max(b.1)));
+        .reduce(|| bounds(std::iter::empty()), |a, b| (a.0.min(b.0), a.1.max(b.1)));
     let scale = 1023.0 / (hi - lo).max(Vec3::splat(f32::MIN_POSITIVE));
     let spread = |mut v: u64| {
         v &= 0x3FF;
