@@ -92,6 +92,20 @@ fn skips(c: &mut Criterion) {
             g.bench_function(label, |b| b.iter(|| black_box(render(scene, &settings, Mode::Quiet).0.mean())));
         }
     }
+    // A pixel's samples sharing their caustic estimate, and each making its own.
+    let room = Scene::tncg15(Eye::One);
+    for reuse in [photonmap::render::CAUSTIC_REUSE, 0.0] {
+        let settings = Settings {
+            photons: 100_000,
+            caustic_photons: 200_000,
+            width: 160,
+            height: 160,
+            caustic_reuse: reuse,
+            ..Settings::default()
+        };
+        let label = format!("caustic_reuse/{}", if reuse > 0.0 { "skip" } else { "no_skip" });
+        g.bench_function(label, |b| b.iter(|| black_box(render(&room, &settings, Mode::Quiet).0.mean())));
+    }
     // Caustic lookups with and without the occupancy grid: a glass ball on
     // a wide floor under the sun, whose caustic map is empty in most places.
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/glass-sun.toml");

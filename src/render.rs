@@ -4,7 +4,7 @@ use crate::camera::Camera;
 use crate::film::Film;
 use crate::integrator::path::PathIntegrator;
 use crate::integrator::photon::{PhotonEstimator, PhotonIntegrator};
-use crate::integrator::{Context, Integrator, Part, Tally};
+use crate::integrator::{Context, Integrator, Part, PixelMemo, Tally};
 use crate::math::max_component;
 use crate::photon::map::Scratch;
 use crate::photon::map::{IrradianceCache, PhotonMap};
@@ -51,6 +51,10 @@ pub struct Settings {
     /// Irradiance is precomputed at every n-th global photon; `None`: at
     /// every (k_global / CACHE_POINTS_PER_DISK)-th ([`cache_stride`]).
     pub cache_stride: Option<usize>,
+    /// A pixel's later samples reuse its last caustic estimate where they
+    /// land on the same surface within this fraction of that estimate's
+    /// radius (0: every sample makes its own).
+    pub caustic_reuse: f32,
     /// Samples of the emitted part in pixels on the rim of a light's image.
     pub edge_spp: u32,
     /// Skip what the scene does not need (photon maps it cannot use, shadow
@@ -78,12 +82,16 @@ impl Default for Settings {
             gather_rays: 4,
             shadow_rays: 2,
             cache_stride: None,
+            caustic_reuse: CAUSTIC_REUSE,
             edge_spp: 256,
             skip: true,
             alpha: 2.0 / 3.0,
         }
     }
 }
+
+/// The default [`Settings::caustic_reuse`].
+pub const CAUSTIC_REUSE: f32 = 0.25;
 
 /// Default caps on the search radius as fractions of the scene diagonal: the
 /// k-nearest estimate sets the radius wherever photons are dense; the cap
@@ -161,6 +169,10 @@ pub struct Stats {
     pub skipped_caustic: bool,
     /// Shadow rays not cast towards lights facing away.
     pub shadow_rays_skipped: u64,
+    /// Caustic estimates made by the camera pass, and those a pixel's
+    /// earlier sample answered ([`Settings::caustic_reuse`]).
+    pub caustic_estimates: u64,
+    pub caustic_reused: u64,
 }
 
 impl Stats {
@@ -195,6 +207,8 @@ impl Stats {
         self.skipped_global = o.skipped_global;
         self.skipped_caustic = o.skipped_caustic;
         self.shadow_rays_skipped += o.shadow_rays_skipped;
+        self.caustic_estimates += o.caustic_estimates;
+        self.caustic_reused += o.caustic_reused;
     }
 }
 
@@ -328,6 +342,7 @@ fn photon_integrator<'a>(
             gather_rays: settings.gather_rays,
             shadow_rays: settings.shadow_rays,
             skip: settings.skip,
+            caustic_reuse: settings.caustic_reuse,
         },
     }
 }
@@ -362,6 +377,8 @@ fn render_pass(scene: &Scene, settings: &Settings, pass: u32, progress: Mode) ->
     stats.first_nonfinite = tally.first_nonfinite;
     stats.edge_pixels = tally.edge_pixels;
     stats.shadow_rays_skipped = tally.shadow_rays_skipped;
+    stats.caustic_estimates = tally.caustic_estimates;
+    stats.caustic_reused = tally.caustic_reused;
     (film, stats)
 }
 
@@ -461,10 +478,11 @@ fn light_rims(camera: &Camera, integrator: &impl Integrator, seed: u64, pass: u6
                 .map(|col| {
                     let pixel = row as u64 * w as u64 + col as u64;
                     let mut rng = stream(seed, Domain::EdgeProbes, sample_index(pass, pixel));
+                    let mut memo = PixelMemo::default();
                     (0..PROBES)
                         .filter(|&s| {
                             let ray = camera.ray(col, row, stratified_2d(s, PROBES, next_2d(&mut rng)));
-                            let mut ctx = Context { rng: &mut rng, scratch, tally: &mut tally, pixel };
+                            let mut ctx = Context { rng: &mut rng, scratch, tally: &mut tally, pixel, memo: &mut memo };
                             max_component(integrator.radiance(ray, Part::Emitted, &mut ctx)) > 0.0
                         })
                         .count() as u8
@@ -532,12 +550,13 @@ fn camera_pass(
                     let pixel = row as u64 * w as u64 + col as u64;
                     let mut rng = stream(settings.seed, Domain::Camera, sample_index(pass, pixel));
                     let rim = rims[pixel as usize];
+                    let mut memo = PixelMemo::default();
                     let mut estimate = |part: Part, n: u32| {
                         let mut sum = DVec3::ZERO;
                         for s in 0..n {
                             let u = stratified_2d(s, n, next_2d(&mut rng));
                             let ray = camera.ray(col, row, u);
-                            let mut ctx = Context { rng: &mut rng, scratch, tally: &mut tally, pixel };
+                            let mut ctx = Context { rng: &mut rng, scratch, tally: &mut tally, pixel, memo: &mut memo };
                             sum += integrator.radiance(ray, part, &mut ctx).as_dvec3();
                         }
                         sum / n as f64

@@ -108,6 +108,11 @@ struct Cli {
     /// 16 at k = 100, following k down in progressive passes].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     cache_stride: Option<u32>,
+    /// A pixel's later camera samples reuse its last caustic estimate where
+    /// they land on the same surface within this fraction of that
+    /// estimate's radius (0 to 1; 0: every sample makes its own).
+    #[arg(long, default_value_t = photonmap::render::CAUSTIC_REUSE, value_parser = parse_fraction)]
+    caustic_reuse: f32,
     /// Samples of the light seen in pixels on the rim of a light's image
     /// (directly or in mirrors and glass; 0: no extra samples).
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(0..=1_000_000))]
@@ -156,6 +161,13 @@ fn parse_radius(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
         _ => Err(format!("'{s}' must be a positive distance")),
+    }
+}
+
+fn parse_fraction(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if (0.0..=1.0).contains(&v) => Ok(v),
+        _ => Err(format!("'{s}' must be a number from 0 to 1")),
     }
 }
 
@@ -241,6 +253,7 @@ fn run(cli: Cli) -> Result<(), Error> {
         shadow_rays: cli.shadow_rays,
         edge_spp: cli.edge_spp,
         cache_stride: cli.cache_stride.map(|n| n as usize),
+        caustic_reuse: cli.caustic_reuse,
         skip: !cli.no_skip,
     };
     // Refuse before allocating: a map that cannot fit would abort the
@@ -448,6 +461,14 @@ fn summary(s: &Stats, settings: &Settings, write_time: std::time::Duration, tota
         "               {} pixels on the rim of a light's image took {} extra samples",
         s.edge_pixels, settings.edge_spp
     );
+    if s.caustic_estimates + s.caustic_reused > 0 {
+        eprintln!(
+            "               {} caustic estimates; {} more samples reused their pixel's last one ({:.0}%)",
+            s.caustic_estimates,
+            s.caustic_reused,
+            100.0 * s.caustic_reused as f64 / (s.caustic_estimates + s.caustic_reused) as f64
+        );
+    }
     let mut skipped = Vec::new();
     if s.skipped_global {
         skipped.push("the global map and its photons (no diffuse surface reflects light)".to_string());

@@ -36,12 +36,32 @@ pub trait Integrator: Sync {
     fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context) -> Color;
 }
 
-/// Per-thread state: random stream, scratch for lookups, counters.
+/// Per-thread state: random stream, scratch for lookups, counters, and
+/// what the pixel's earlier samples left for its later ones.
 pub struct Context<'r> {
     pub rng: &'r mut Rng,
     pub scratch: &'r mut Scratch,
     pub tally: &'r mut Tally,
     pub pixel: u64,
+    pub memo: &'r mut PixelMemo,
+}
+
+/// What one pixel's samples share, and only they: it starts empty at every
+/// pixel, so a pixel's value never depends on which thread rendered it or
+/// on the pixels before.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PixelMemo {
+    /// The pixel's last caustic estimate: where it was made, on what
+    /// surface, and how far from there it may stand in for a new one.
+    pub caustic: Option<CausticMemo>,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct CausticMemo {
+    pub point: Vec3,
+    pub normal: Vec3,
+    pub reach2: f32,
+    pub estimate: crate::photon::map::ConeEstimate,
 }
 
 impl Context<'_> {
@@ -69,6 +89,9 @@ pub struct Tally {
     pub edge_pixels: usize,
     /// Shadow rays not cast: the light's back faced the point.
     pub shadow_rays_skipped: u64,
+    /// Caustic estimates made, and those a pixel's earlier sample answered.
+    pub caustic_estimates: u64,
+    pub caustic_reused: u64,
     /// First non-finite sample seen: (pixel index, estimator name).
     pub first_nonfinite: Option<(u64, &'static str)>,
 }
@@ -79,6 +102,8 @@ impl Tally {
         self.nonfinite += other.nonfinite;
         self.edge_pixels += other.edge_pixels;
         self.shadow_rays_skipped += other.shadow_rays_skipped;
+        self.caustic_estimates += other.caustic_estimates;
+        self.caustic_reused += other.caustic_reused;
         self.first_nonfinite = match (self.first_nonfinite, other.first_nonfinite) {
             (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
             (a, b) => a.or(b),

@@ -16,7 +16,7 @@
 //! Gather rays that reach a light (directly or through mirrors and glass)
 //! add nothing: those paths belong to the first two rows.
 
-use super::{direct_light, glass_branches, Context, Integrator, Part};
+use super::{direct_light, glass_branches, CausticMemo, Context, Integrator, Part};
 use crate::material::{Material, Phong};
 use crate::math::{max_component, Color, Frame, Ray};
 use crate::photon::map::{CellRange, IrradianceCache, PhotonMap};
@@ -33,6 +33,11 @@ const SPLIT_DEPTH: u32 = 2;
 /// Specular chains are cut after this many bounces (light trapped by total
 /// internal reflection; its share is negligible).
 const MAX_SPECULAR_DEPTH: u32 = 24;
+
+/// A caustic estimate stands in only for points on a surface facing within
+/// this (cosine) of its own: the same plane, or a curved surface's nearby
+/// point.
+const REUSE_NORMAL_COSINE: f32 = 0.999;
 
 /// Gather rays traced before their cache reads (see `indirect`).
 const GATHER_BATCH: usize = 8;
@@ -57,6 +62,9 @@ pub struct PhotonEstimator {
     pub shadow_rays: u32,
     /// Skip lights that face away from the shaded point.
     pub skip: bool,
+    /// A pixel's later samples reuse its last caustic estimate within this
+    /// fraction of its radius, on the same surface (0: never).
+    pub caustic_reuse: f32,
 }
 
 pub struct PhotonIntegrator<'a> {
@@ -178,7 +186,20 @@ impl PhotonIntegrator<'_> {
         if self.caustic.is_empty() {
             return Color::ZERO;
         }
-        self.caustic.radiance_cone(hit.point, n, rho, self.settings.k_caustic, self.settings.r_caustic, ctx.scratch)
+        if let Some(m) = ctx.memo.caustic {
+            if m.normal.dot(n) >= REUSE_NORMAL_COSINE && m.point.distance_squared(hit.point) <= m.reach2 {
+                ctx.tally.caustic_reused += 1;
+                return m.estimate.radiance(rho);
+            }
+        }
+        let s = &self.settings;
+        let estimate = self.caustic.cone_estimate(hit.point, n, s.k_caustic, s.r_caustic, ctx.scratch);
+        ctx.tally.caustic_estimates += 1;
+        if s.caustic_reuse > 0.0 {
+            let reach2 = s.caustic_reuse * s.caustic_reuse * estimate.r2;
+            ctx.memo.caustic = Some(CausticMemo { point: hit.point, normal: n, reach2, estimate });
+        }
+        estimate.radiance(rho)
     }
 
     /// Light → … diffuse y → (specular*) → x: final gathering.

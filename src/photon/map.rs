@@ -354,9 +354,15 @@ impl PhotonMap {
     /// estimated with Jensen's cone filter (k = 1: weight 1 - d / r,
     /// normalised by 1 / (1 - 2/3)), which keeps caustic edges sharp.
     pub fn radiance_cone(&self, x: Vec3, n: Vec3, rho: Color, k: usize, r_max: f32, buf: &mut Scratch) -> Color {
+        self.cone_estimate(x, n, k, r_max, buf).radiance(rho)
+    }
+
+    /// The photons' share of [`Self::radiance_cone`], which any reflectance
+    /// turns into radiance.
+    pub fn cone_estimate(&self, x: Vec3, n: Vec3, k: usize, r_max: f32, buf: &mut Scratch) -> ConeEstimate {
         let g = self.gather(x, k, r_max, buf);
         if g.count == 0 || !(g.r2 > 0.0) {
-            return Color::ZERO;
+            return ConeEstimate { weighted_flux: Color::ZERO, r2: g.r2 };
         }
         let r = g.r2.sqrt();
         buf.terms.clear();
@@ -367,8 +373,25 @@ impl PhotonMap {
                 .filter(|&(_, i)| self.faces(i, n))
                 .map(|(d2, i)| self.photons[i as usize].flux() * (1.0 - d2.sqrt() / r).max(0.0)),
         );
-        let flux = order_free_sum(&buf.terms);
-        rho / PI * flux * 3.0 / (PI * g.r2)
+        ConeEstimate { weighted_flux: order_free_sum(&buf.terms), r2: g.r2 }
+    }
+}
+
+/// A cone-filtered estimate: the photons' flux times their cone weights,
+/// and the squared radius of the disk.
+#[derive(Clone, Copy, Debug)]
+pub struct ConeEstimate {
+    pub weighted_flux: Color,
+    pub r2: f32,
+}
+
+impl ConeEstimate {
+    /// Radiance reflected by a Lambertian surface of reflectance `rho`.
+    pub fn radiance(&self, rho: Color) -> Color {
+        if !(self.r2 > 0.0) {
+            return Color::ZERO;
+        }
+        rho / PI * self.weighted_flux * 3.0 / (PI * self.r2)
     }
 }
 
