@@ -91,7 +91,7 @@ impl Default for Settings {
 }
 
 /// The default [`Settings::caustic_reuse`].
-pub const CAUSTIC_REUSE: f32 = 0.25;
+pub const CAUSTIC_REUSE: f32 = 0.1;
 
 /// Default caps on the search radius as fractions of the scene diagonal: the
 /// k-nearest estimate sets the radius wherever photons are dense; the cap
