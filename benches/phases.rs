@@ -92,14 +92,17 @@ fn skips(c: &mut Criterion) {
             g.bench_function(label, |b| b.iter(|| black_box(render(scene, &settings, Mode::Quiet).0.mean())));
         }
     }
-    // A pixel's samples sharing their caustic estimate, and each making its own.
+    // A pixel's samples sharing their caustic estimate, and each making its
+    // own: pixels small enough for the samples to land within reach (at
+    // 160 x 160 they rarely do), one gather ray to keep it short.
     let room = Scene::tncg15(Eye::One);
     for reuse in [photonmap::render::CAUSTIC_REUSE, 0.0] {
         let settings = Settings {
             photons: 100_000,
             caustic_photons: 200_000,
-            width: 160,
-            height: 160,
+            width: 400,
+            height: 400,
+            gather_rays: 1,
             caustic_reuse: reuse,
             ..Settings::default()
         };
