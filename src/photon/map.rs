@@ -8,7 +8,7 @@
 //! so that neighbours in space are neighbours in memory.
 
 use super::{quantize_normal, Photon, PhotonBlocks};
-use crate::math::Color;
+use crate::math::{floor_i32, Color};
 use glam::{EulerRot, Mat3, Vec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
@@ -181,8 +181,8 @@ impl Occupancy {
     }
 
     fn cell_of(&self, x: Vec3) -> [i32; 3] {
-        let c = ((x - self.lo) / self.cell).floor();
-        [c.x as i32, c.y as i32, c.z as i32]
+        let c = (x - self.lo) / self.cell;
+        [floor_i32(c.x), floor_i32(c.y), floor_i32(c.z)]
     }
 
     fn index(&self, c: [i32; 3]) -> usize {
@@ -499,8 +499,10 @@ const EMPTY: u64 = u64::MAX;
 
 impl CellIndex {
     fn key(&self, x: Vec3) -> Option<u64> {
-        let c = ((x - self.lo) * self.inv_cell).floor();
-        // Outside the grid (or not finite): no cell.
+        let c = (x - self.lo) * self.inv_cell;
+        // Outside the grid (or not finite): no cell. Inside, the cell is
+        // the coordinates' floor, which for these non-negative values the
+        // cast to an integer takes (f32::floor is a library call here).
         if !(c.min_element() >= 0.0 && c.max_element() < (1u32 << CELL_BITS) as f32) {
             return None;
         }
