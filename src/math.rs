@@ -127,9 +127,32 @@ mod tests {
     #[test]
     fn floor_i32_is_floor_then_cast() {
         let mut rng = crate::sampling::stream(9, crate::sampling::Domain::Camera, 0);
-        let special = [0.0f32, -0.0, 0.5, -0.5, 1.0, -1.0, 0.99999994, -0.99999994, 1e-40, -1e-40, 2147483520.0,
-            -2147483648.0, 2147483648.0, -2147483904.0, 3e9, -3e9, f32::MAX, f32::MIN, f32::INFINITY,
-            f32::NEG_INFINITY, f32::NAN, 8388607.5, -8388607.5, 16777217.0];
+        let special = [
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            0.99999994,
+            -0.99999994,
+            1e-40,
+            -1e-40,
+            2147483520.0,
+            -2147483648.0,
+            2147483648.0,
+            -2147483904.0,
+            3e9,
+            -3e9,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            8388607.5,
+            -8388607.5,
+            16777217.0,
+        ];
         let random = (0..1_000_000).map(|_| f32::from_bits(rand::RngExt::random::<u32>(&mut rng)));
         let small = (-200_000..200_000).map(|i| i as f32 * 0.013);
         for x in special.into_iter().chain(random).chain(small) {

@@ -49,12 +49,27 @@ pub fn concentric_disk(u: Vec2) -> Vec2 {
     if o.x == 0.0 && o.y == 0.0 {
         return Vec2::ZERO;
     }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, FRAC_PI_4 * (o.y / o.x))
+    // The angle is pi/4 times a ratio in [-1, 1], measured from the x axis
+    // (or, with sine and cosine swapped, from the y axis), so sine and
+    // cosine are needed only on [-pi/4, pi/4], where short polynomials
+    // reach f32 precision without the library's range reduction.
+    if o.x.abs() > o.y.abs() {
+        let (s, c) = sin_cos_quarter(FRAC_PI_4 * (o.y / o.x));
+        o.x * Vec2::new(c, s)
     } else {
-        (o.y, std::f32::consts::FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y))
-    };
-    r * Vec2::new(theta.cos(), theta.sin())
+        let (s, c) = sin_cos_quarter(FRAC_PI_4 * (o.x / o.y));
+        o.y * Vec2::new(s, c)
+    }
+}
+
+/// (sin t, cos t) for |t| <= pi/4, within 2e-7 of the exact values:
+/// Cephes' minimax polynomials for `sinf` / `cosf` on that interval.
+#[inline]
+fn sin_cos_quarter(t: f32) -> (f32, f32) {
+    let z = t * t;
+    let s = ((-1.951_529_6e-4 * z + 8.332_161e-3) * z - 1.666_665_5e-1) * z * t + t;
+    let c = ((2.443_315_7e-5 * z - 1.388_731_6e-3) * z + 4.166_664_6e-2) * z * z - 0.5 * z + 1.0;
+    (s, c)
 }
 
 /// Cosine-weighted direction on the hemisphere around local +z (Malley).
@@ -120,6 +135,46 @@ pub fn stratified_2d(index: u32, n: u32, u: Vec2) -> Vec2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn quarter_sine_and_cosine_are_accurate() {
+        let n = 1_000_000;
+        let mut worst = 0.0f64;
+        for i in 0..=n {
+            let t = (i as f32 / n as f32 * 2.0 - 1.0) * FRAC_PI_4;
+            let (s, c) = sin_cos_quarter(t);
+            let (es, ec) = (t as f64).sin_cos();
+            worst = worst.max((s as f64 - es).abs()).max((c as f64 - ec).abs());
+        }
+        assert!(worst < 2e-7, "worst error {worst:e}");
+    }
+
+    #[test]
+    fn concentric_disk_matches_the_trigonometric_map() {
+        // The map as Shirley and Chiu wrote it, with the library's sine and cosine.
+        let reference = |u: Vec2| {
+            let o = 2.0 * u - Vec2::ONE;
+            let (r, theta) = if o.x.abs() > o.y.abs() {
+                (o.x as f64, std::f64::consts::FRAC_PI_4 * (o.y as f64 / o.x as f64))
+            } else {
+                (o.y as f64, std::f64::consts::FRAC_PI_2 - std::f64::consts::FRAC_PI_4 * (o.x as f64 / o.y as f64))
+            };
+            (r * theta.cos(), r * theta.sin())
+        };
+        let n = 700;
+        for i in 0..=n {
+            for j in 0..=n {
+                let u = Vec2::new(i as f32 / n as f32, j as f32 / n as f32);
+                if u == Vec2::splat(0.5) {
+                    continue;
+                }
+                let d = concentric_disk(u);
+                let (x, y) = reference(u);
+                assert!((d.x as f64 - x).abs() < 4e-7 && (d.y as f64 - y).abs() < 4e-7, "{u}: {d} vs ({x}, {y})");
+            }
+        }
+        assert_eq!(concentric_disk(Vec2::splat(0.5)), Vec2::ZERO);
+    }
 
     /// Pearson's chi-square statistic of `counts` against equal expectation.
     fn chi_square(counts: &[u32]) -> f64 {
