@@ -102,11 +102,11 @@ pub const CAUSTIC_RADIUS_FRACTION: f32 = 0.01;
 impl Settings {
     /// Bytes the render will hold at its peak, estimated from the measured
     /// default scene: ~5 stored global photons per emitted one (Russian
-    /// roulette with albedo 0.8), each 32 bytes plus ~16 in the kd-tree and
+    /// roulette with albedo 0.8), each 28 bytes plus ~16 in the kd-tree and
     /// as much again while the tree is built; one caustic photon per emitted
     /// one; the film in f32 and its rows in flight.
     pub fn estimated_peak_bytes(&self) -> u64 {
-        let per_photon = 32 + 16 + 24;
+        let per_photon = std::mem::size_of::<crate::photon::Photon>() as u64 + 16 + 24;
         let global = self.photons.saturating_mul(5).saturating_mul(per_photon);
         let caustic = self.caustic_photons.saturating_mul(per_photon);
         let film = (self.width as u64) * (self.height as u64) * 2 * 12;

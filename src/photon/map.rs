@@ -733,7 +733,7 @@ mod tests {
         let photons: Vec<Photon> = (0..n)
             .map(|_| {
                 let u = next_2d(&mut rng) * side;
-                Photon::new(Vec3::new(u.x, u.y, 0.0), Color::splat(power), Vec3::Z, Vec3::Z)
+                Photon::new(Vec3::new(u.x, u.y, 0.0), Color::splat(power), Vec3::Z)
             })
             .collect();
         let map = PhotonMap::build(photons);
@@ -779,9 +779,9 @@ mod tests {
             .map(|i| {
                 let u = next_2d(&mut rng) * 4.0;
                 match i % 3 {
-                    0 => Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y, Vec3::Y),
-                    1 => Photon::new(Vec3::new(1.5 + u.x / 8.0, 0.0, u.y), Color::splat(2.0), Vec3::Y, Vec3::Y),
-                    _ => Photon::new(Vec3::new(0.0, u.x, u.y), Color::splat(0.5), Vec3::X, Vec3::X),
+                    0 => Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y),
+                    1 => Photon::new(Vec3::new(1.5 + u.x / 8.0, 0.0, u.y), Color::splat(2.0), Vec3::Y),
+                    _ => Photon::new(Vec3::new(0.0, u.x, u.y), Color::splat(0.5), Vec3::X),
                 }
             })
             .collect();
@@ -810,7 +810,7 @@ mod tests {
         let photons: Vec<Photon> = (0..100_000)
             .map(|_| {
                 let u = next_2d(&mut rng) * 4.0;
-                Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y, Vec3::Y)
+                Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y)
             })
             .collect();
         let map = PhotonMap::build(photons);
@@ -838,9 +838,9 @@ mod tests {
             .map(|i| {
                 let u = next_2d(&mut rng) * 4.0;
                 if i % 2 == 0 {
-                    Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y, Vec3::Y)
+                    Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y)
                 } else {
-                    Photon::new(Vec3::new(0.0, u.x, u.y), Color::splat(3.0), Vec3::X, Vec3::X)
+                    Photon::new(Vec3::new(0.0, u.x, u.y), Color::splat(3.0), Vec3::X)
                 }
             })
             .collect();

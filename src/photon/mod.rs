@@ -18,7 +18,7 @@ pub use blocks::PhotonBlocks;
 use crate::math::Color;
 use glam::Vec3;
 
-/// One stored photon: 32 bytes.
+/// One stored photon: 28 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C)]
 pub struct Photon {
@@ -28,21 +28,15 @@ pub struct Photon {
     /// Surface normal at the hit, turned towards the side the photon arrived
     /// from, as three signed bytes (n * 127): estimates skip photons on
     /// other surfaces, a test that needs no precision but must be cheap.
+    /// (No incoming direction: photons are stored and read only on
+    /// Lambertian surfaces and lobes, whose estimate does not use it.)
     pub normal: [i8; 4],
-    /// Direction towards where the photon came from (octahedral), for
-    /// non-Lambertian BRDFs.
-    pub dir: u32,
 }
 
 impl Photon {
-    pub fn new(pos: Vec3, power: Color, normal: Vec3, towards_source: Vec3) -> Self {
+    pub fn new(pos: Vec3, power: Color, normal: Vec3) -> Self {
         debug_assert!(power.is_finite() && pos.is_finite(), "photon power {power} at {pos}");
-        Photon {
-            pos: pos.to_array(),
-            power: power.to_array(),
-            normal: quantize_normal(normal),
-            dir: oct_encode(towards_source),
-        }
+        Photon { pos: pos.to_array(), power: power.to_array(), normal: quantize_normal(normal) }
     }
 
     pub fn position(&self) -> Vec3 {
@@ -60,7 +54,7 @@ impl Photon {
 
 /// The nearest integer (halves away from zero) of a float within +-2^22,
 /// inline: `f32::round` is a library call on the default x86-64 target (no
-/// SSE4.1), and every stored photon rounded five values.
+/// SSE4.1), and every stored photon rounds three values.
 #[inline]
 fn round(x: f32) -> i32 {
     // Truncate, then step by the fraction (exact: |x| < 2^23). Adding 0.5
@@ -74,31 +68,6 @@ fn round(x: f32) -> i32 {
 pub fn quantize_normal(n: Vec3) -> [i8; 4] {
     let q = (n * 127.0).clamp(Vec3::splat(-127.0), Vec3::splat(127.0));
     [round(q.x) as i8, round(q.y) as i8, round(q.z) as i8, 0]
-}
-
-/// Octahedral encoding of a unit vector into two signed 16-bit values
-/// (Cigolle et al. 2014); the error is below 1e-4 radians.
-pub fn oct_encode(v: Vec3) -> u32 {
-    let l1 = v.x.abs() + v.y.abs() + v.z.abs();
-    if !(l1 > 0.0) {
-        return 0;
-    }
-    let (mut x, mut y) = (v.x / l1, v.y / l1);
-    if v.z < 0.0 {
-        let (ox, oy) = (x, y);
-        x = (1.0 - oy.abs()) * ox.signum();
-        y = (1.0 - ox.abs()) * oy.signum();
-    }
-    let q = |f: f32| (round(f.clamp(-1.0, 1.0) * 32767.0) as i16) as u16 as u32;
-    q(x) | (q(y) << 16)
-}
-
-pub fn oct_decode(e: u32) -> Vec3 {
-    let x = (e & 0xFFFF) as u16 as i16 as f32 / 32767.0;
-    let y = (e >> 16) as u16 as i16 as f32 / 32767.0;
-    let z = 1.0 - x.abs() - y.abs();
-    let (x, y) = if z < 0.0 { ((1.0 - y.abs()) * x.signum(), (1.0 - x.abs()) * y.signum()) } else { (x, y) };
-    Vec3::new(x, y, z).normalize_or_zero()
 }
 
 #[cfg(test)]
@@ -117,21 +86,7 @@ mod tests {
     }
 
     #[test]
-    fn photon_is_32_bytes() {
-        assert_eq!(std::mem::size_of::<Photon>(), 32);
-    }
-
-    #[test]
-    fn octahedral_round_trip() {
-        let mut rng = crate::sampling::stream(1, crate::sampling::Domain::Camera, 9);
-        for _ in 0..10_000 {
-            let u = crate::sampling::next_2d(&mut rng);
-            let v = crate::sampling::uniform_cone(u, -1.0);
-            let back = oct_decode(oct_encode(v));
-            assert!((v - back).length() < 2e-4, "{v} {back}");
-        }
-        for v in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
-            assert!((v - oct_decode(oct_encode(v))).length() < 1e-4);
-        }
+    fn photon_is_28_bytes() {
+        assert_eq!(std::mem::size_of::<Photon>(), 28);
     }
 }

@@ -229,13 +229,13 @@ fn follow(
                     // bounce it is indirect light (final gathering counts it).
                     Pass::Caustic => {
                         if only_specular_so_far && specular_bounces > 0 && max_component(rho) > 0.0 {
-                            out.push(Photon::new(hit.point, power, n, -ray.dir));
+                            out.push(Photon::new(hit.point, power, n));
                         }
                         break;
                     }
                     Pass::Global => {
                         if max_component(rho) > 0.0 {
-                            out.push(Photon::new(hit.point, power, n, -ray.dir));
+                            out.push(Photon::new(hit.point, power, n));
                         }
                     }
                 }
@@ -255,9 +255,9 @@ fn follow(
                 let store = max_component(rho) > 0.0;
                 match pass {
                     Pass::Caustic if store && only_specular_so_far && specular_bounces > 0 => {
-                        out.push(Photon::new(hit.point, power, n, -ray.dir));
+                        out.push(Photon::new(hit.point, power, n));
                     }
-                    Pass::Global if store => out.push(Photon::new(hit.point, power, n, -ray.dir)),
+                    Pass::Global if store => out.push(Photon::new(hit.point, power, n)),
                     _ => {}
                 }
                 let Some((lobe, prob)) = p.choose_lobe(rng.random::<f32>()) else {
