@@ -399,17 +399,27 @@ impl Shape {
     /// Closest intersection in (0, t_max), honouring the departure rules of the
     /// module docs when `departed` is this primitive's own departure.
     pub fn intersect(&self, ray: &Ray, t_max: f32, departed: Option<bool>) -> Option<ShapeHit> {
-        self.distance(ray, &RayShear::new(ray), t_max, departed).map(|(t, uv)| self.record(ray, t, uv))
+        self.distance(ray, &std::cell::OnceCell::new(), t_max, departed).map(|(t, uv)| self.record(ray, t, uv))
     }
 
     /// Distance to the intersection (and the triangle's barycentrics, for
-    /// [`Shape::record`]), without building the hit record.
+    /// [`Shape::record`]), without building the hit record. `rs` holds the
+    /// ray's shear once a triangle has needed it: most rays in a room meet
+    /// no triangle's box, and its setup branches on the ray's dominant axis.
     #[inline]
-    pub fn distance(&self, ray: &Ray, rs: &RayShear, t_max: f32, departed: Option<bool>) -> Option<(f32, [f32; 2])> {
+    pub fn distance(
+        &self,
+        ray: &Ray,
+        rs: &std::cell::OnceCell<RayShear>,
+        t_max: f32,
+        departed: Option<bool>,
+    ) -> Option<(f32, [f32; 2])> {
         match self {
             // A ray never meets the plane it leaves again.
             Shape::Triangle(_) | Shape::Disk(_) if departed.is_some() => None,
-            Shape::Triangle(tri) => tri.distance(ray, rs, t_max).map(|(t, u, v)| (t, [u, v])),
+            Shape::Triangle(tri) => {
+                tri.distance(ray, rs.get_or_init(|| RayShear::new(ray)), t_max).map(|(t, u, v)| (t, [u, v]))
+            }
             Shape::Disk(disk) => disk.distance(ray, t_max).map(|t| (t, [0.0; 2])),
             Shape::Sphere(s) => s.distance(ray, t_max, departed).map(|t| (t, [0.0; 2])),
             Shape::Ellipsoid(e) => e.distance(ray, t_max, departed).map(|t| (t, [0.0; 2])),

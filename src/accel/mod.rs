@@ -11,7 +11,7 @@
 pub mod enclosure;
 
 use crate::math::Ray;
-use crate::shape::{Departure, RayShear, Shape, ShapeHit};
+use crate::shape::{Departure, Shape, ShapeHit};
 use enclosure::Enclosure;
 use glam::{Vec3, Vec3A};
 
@@ -123,7 +123,7 @@ impl Accel {
     pub fn closest_hit(&self, ray: &Ray, departure: Option<Departure>, t_max: f32) -> Option<(u32, ShapeHit)> {
         let wall = self.enclosure_hit(ray, departure, t_max);
         let mut best: Option<(&Shape, u32, f32, [f32; 2])> = None;
-        let rs = RayShear::new(ray);
+        let rs = std::cell::OnceCell::new();
         self.traverse(ray, Self::inside_limit(wall, t_max), |shape, index, t_limit| {
             let departed = departure.filter(|d| d.prim == index).map(|d| d.outward);
             if let Some((t, uv)) = shape.distance(ray, &rs, *t_limit, departed) {
@@ -143,7 +143,7 @@ impl Accel {
     /// Primitives a closest-hit query tests (a diagnostic of the tree's quality).
     pub fn count_tests(&self, ray: &Ray) -> u64 {
         let mut n = 0;
-        let rs = RayShear::new(ray);
+        let rs = std::cell::OnceCell::new();
         let wall = self.enclosure_hit(ray, None, f32::INFINITY);
         self.traverse(ray, Self::inside_limit(wall, f32::INFINITY), |shape, _, t_limit| {
             n += 1;
@@ -162,7 +162,7 @@ impl Accel {
             return true;
         }
         let mut blocked = false;
-        let rs = RayShear::new(ray);
+        let rs = std::cell::OnceCell::new();
         self.traverse(ray, t_max, |shape, index, t_limit| {
             if ignore == Some(index) {
                 return false;
