@@ -111,7 +111,7 @@ fn skips(c: &mut Criterion) {
         let label = format!("caustic_reuse/{}", if reuse > 0.0 { "skip" } else { "no_skip" });
         g.bench_function(label, |b| b.iter(|| black_box(render(&room, &settings, Mode::Quiet).0.mean())));
     }
-    // Caustic lookups with and without the occupancy grid: a glass ball on
+    // Caustic lookups with and without the map's grid: a glass ball on
     // a wide floor under the sun, whose caustic map is empty in most places.
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/glass-sun.toml");
     let glass_only = Scene::from_parts(photonmap::scene::file::load(&path).unwrap().parts);
@@ -119,7 +119,8 @@ fn skips(c: &mut Criterion) {
     let photons = trace_pass(&glass_only, Pass::Caustic, 200_000, 1, &|_| {}).photons;
     let r = Settings::default().r_caustic(&glass_only);
     for skip in [true, false] {
-        let map = PhotonMap::build(photons.clone()).with_occupancy(skip.then_some(r));
+        let map = PhotonMap::build_with_grid(photons.clone(), Some(r));
+        let map = if skip { map } else { map.without_grid() };
         let label = format!("glass_sun_caustic_lookups/{}", if skip { "skip" } else { "no_skip" });
         g.throughput(Throughput::Elements(points.len() as u64));
         g.bench_function(label, |b| {

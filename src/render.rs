@@ -152,7 +152,7 @@ pub struct Stats {
     pub edge_pixels: usize,
     pub first_nonfinite: Option<(u64, &'static str)>,
     pub photon_time: Duration,
-    /// The map build: kd-trees (Morton sort, trees, occupancy grid), then
+    /// The map build: kd-trees (Morton sort, trees, the caustic map's grid), then
     /// the irradiance cache (estimates at photons, their grid and tree).
     pub tree_time: Duration,
     pub cache_time: Duration,
@@ -297,12 +297,21 @@ fn photon_pass(
     stats.photon_rays += global.rays + caustic.rays;
 
     let t = Instant::now();
-    // Caustic lookups may meet empty regions of the map; global-map
-    // lookups run at photons (the irradiance cache) and need no grid. The
-    // two builds at once: each has serial stretches the other can fill.
+    // Caustic lookups run at every visible diffuse point and mostly near
+    // the radius cap: the grid serves them (and rejects empty regions);
+    // global-map lookups run at photons (the irradiance cache) and need no
+    // grid. The two builds at once: each has serial stretches the other
+    // can fill.
     let (global_map, caustic_map) = rayon::join(
         || PhotonMap::build(global.photons),
-        || PhotonMap::build(caustic.photons).with_occupancy(settings.skip.then_some(est.r_caustic)),
+        || {
+            let map = PhotonMap::build_with_grid(caustic.photons, Some(est.r_caustic));
+            if settings.skip {
+                map
+            } else {
+                map.without_grid()
+            }
+        },
     );
     stats.tree_time += t.elapsed();
     let t = Instant::now();

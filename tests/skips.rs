@@ -145,16 +145,16 @@ fn a_pixels_samples_share_their_caustic_estimate() {
 }
 
 /// Caustic lookups where the map holds no photon within the radius cap are
-/// answered by the occupancy grid without the kd-tree (a glass ball on a
-/// wide floor under the sun, scenes/glass-sun.toml). Every estimate is the
-/// same bit for bit with the grid and without it.
+/// answered by the map's grid without the kd-tree (a glass ball on a wide
+/// floor under the sun, scenes/glass-sun.toml). Every estimate is the same
+/// bit for bit with the grid and without it (the tree alone).
 #[test]
 fn caustic_lookups_where_the_map_is_empty_skip_the_tree() {
     let (scene, points) = glass_sun_and_floor_points();
     let photons = trace_pass(&scene, Pass::Caustic, 100_000, 1, &|_| {}).photons;
     let r = Settings::default().r_caustic(&scene);
-    let with = PhotonMap::build(photons.clone()).with_occupancy(Some(r));
-    let without = PhotonMap::build(photons);
+    let with = PhotonMap::build_with_grid(photons.clone(), Some(r));
+    let without = PhotonMap::build_with_grid(photons, Some(r)).without_grid();
     let (mut a, mut b) = (Scratch::default(), Scratch::default());
     let (mut empty, mut rejected) = (0, 0);
     for &(x, n) in &points {

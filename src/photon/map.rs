@@ -5,7 +5,9 @@
 //! on axis-aligned walls share one coordinate exactly, which makes kd-tree
 //! splits degenerate and queries slow (shared/research/ecosystem.md §2);
 //! distances are unchanged by a rotation. Photons are stored in Morton order
-//! so that neighbours in space are neighbours in memory.
+//! so that neighbours in space are neighbours in memory; a map read at
+//! visible surfaces (the caustic map) is then sorted by the cells of a
+//! uniform grid, through which most of its lookups go instead of the tree.
 
 use super::{quantize_normal, Photon, PhotonBlocks};
 use crate::math::{floor_i32, Color};
@@ -30,8 +32,8 @@ const NORMAL_COSINE: f32 = 0.9;
 pub struct Scratch {
     /// Photons found, as [`found`] keys.
     buf: Vec<u64>,
-    /// The terms of an estimate's sum.
-    terms: Vec<Color>,
+    /// A copy of `buf` to select the k-th nearest in, leaving `buf`'s order.
+    select: Vec<u64>,
     hint_r2: f32,
 }
 
@@ -84,6 +86,13 @@ impl PointTree {
             let n = tree.query(&(self.rot * x).to_array()).nearest_one::<SquaredEuclidean<f32>>().execute();
             (n.distance, n.item)
         })
+    }
+
+    /// Calls `f` with the index of every point within sqrt(r2) of x.
+    fn visit(&self, x: Vec3, r2: f32, mut f: impl FnMut(u32)) {
+        if let Some(tree) = &self.tree {
+            tree.query(&(self.rot * x).to_array()).within::<SquaredEuclidean<f32>>(r2).unsorted().visit(|n| f(n.item));
+        }
     }
 
     /// Pushes (squared distance, index) of every point within sqrt(r2) of x.
@@ -146,78 +155,135 @@ fn morton_sorted(photons: &PhotonBlocks) -> Vec<Photon> {
         .collect()
 }
 
-/// A bitmap over the map's bounds of the cells that hold a photon, with
-/// cells as wide as the lookups' radius cap: a lookup whose own cell and
-/// the 26 around it are empty can find nothing, and skips the kd-tree
-/// (whose growing-radius search would descend it several times to learn
-/// that).
-struct Occupancy {
+/// A uniform grid over the map's bounds whose cells hold contiguous ranges
+/// of the photons (sorted by cell, rows along x, so a row of cells is one
+/// range). A lookup near the radius cap reads a few rows of photons in
+/// memory order instead of descending the kd-tree: the caustic estimates
+/// are mostly sparse (77% need more than half the cap), where a tree
+/// search visits many leaves for ~100 photons. Where the rows hold too many
+/// photons (the caustic's focus) the tree answers. A lookup whose rows are
+/// all empty finds nothing without either.
+struct CellGrid {
     lo: Vec3,
-    cell: f32,
+    inv_cell: f32,
     dims: [i32; 3],
-    bits: Vec<u64>,
+    /// `start[c]..start[c + 1]`: the photons of cell `c` (x fastest).
+    start: Vec<u32>,
 }
 
-/// Cells at most; a larger grid gets wider cells.
-const OCCUPANCY_MAX_CELLS: f32 = 16_777_216.0;
+/// Cells at most (4 bytes each); a larger grid gets wider cells.
+const GRID_MAX_CELLS: f32 = 4_194_304.0;
 
-impl Occupancy {
-    fn build(photons: &[Photon], cell: f32) -> Option<Self> {
+/// Grid cells per lookup radius cap: the rows a lookup at the cap reads
+/// cover (2 + 1/2)^2 r^2 of a surface on average, 1.3x the 4 r^2 a square
+/// around the disk would, in at most 5 x 5 rows.
+const GRID_CELLS_PER_CAP: f32 = 2.0;
+
+/// Rows a grid lookup reads at most (more: the tree answers).
+const GRID_MAX_ROWS: usize = 64;
+
+/// Photons a grid lookup scans at most (more: the tree answers, as it is
+/// faster than a scan of ~2,000 photons).
+const GRID_MAX_SCAN: u32 = 2048;
+
+impl CellGrid {
+    /// The grid for `photons` with cells `cell` wide (wider if the bounds
+    /// would need too many), and the photons sorted by cell, keeping their
+    /// order within a cell.
+    fn build(photons: Vec<Photon>, cell: f32) -> (Option<Self>, Vec<Photon>) {
         let (lo, hi) = bounds(photons.iter().map(Photon::position));
         let extent = hi - lo;
-        if !(cell > 0.0) || !extent.is_finite() || !cell.is_finite() {
-            return None;
+        if photons.is_empty() || !(cell > 0.0) || !extent.is_finite() || !cell.is_finite() {
+            return (None, photons);
         }
         let cells = ((extent / cell).floor() + 1.0).element_product();
-        let cell = if cells > OCCUPANCY_MAX_CELLS { cell * (cells / OCCUPANCY_MAX_CELLS).cbrt() * 1.01 } else { cell };
+        let cell = if cells > GRID_MAX_CELLS { cell * (cells / GRID_MAX_CELLS).cbrt() * 1.01 } else { cell };
         let d = (extent / cell).as_ivec3() + 1;
-        let dims = [d.x, d.y, d.z];
-        let mut grid = Occupancy { lo, cell, dims, bits: vec![0; (d.x * d.y * d.z) as usize / 64 + 1] };
-        for p in photons {
-            let i = grid.index(grid.cell_of(p.position()));
-            grid.bits[i / 64] |= 1 << (i % 64);
+        let mut grid = CellGrid { lo, inv_cell: 1.0 / cell, dims: [d.x, d.y, d.z], start: Vec::new() };
+        // A counting sort: stable, so Morton order survives within cells.
+        let n_cells = (d.x * d.y * d.z) as usize;
+        let cell_of: Vec<u32> = photons.iter().map(|p| grid.index(grid.cell_of(p.position())) as u32).collect();
+        let mut start = vec![0u32; n_cells + 1];
+        for &c in &cell_of {
+            start[c as usize + 1] += 1;
         }
-        Some(grid)
+        for c in 0..n_cells {
+            start[c + 1] += start[c];
+        }
+        let mut next = start.clone();
+        let mut sorted = vec![Photon::default(); photons.len()];
+        for (p, &c) in photons.iter().zip(&cell_of) {
+            sorted[next[c as usize] as usize] = *p;
+            next[c as usize] += 1;
+        }
+        grid.start = start;
+        (Some(grid), sorted)
     }
 
+    /// The cell holding `x`, clamped to the grid.
     fn cell_of(&self, x: Vec3) -> [i32; 3] {
-        let c = (x - self.lo) / self.cell;
-        [floor_i32(c.x), floor_i32(c.y), floor_i32(c.z)]
+        let c = (x - self.lo) * self.inv_cell;
+        [0, 1, 2].map(|a| floor_i32(c[a]).clamp(0, self.dims[a] - 1))
     }
 
     fn index(&self, c: [i32; 3]) -> usize {
         ((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]) as usize
     }
 
-    fn occupied(&self, c: [i32; 3]) -> bool {
-        if (0..3).any(|a| c[a] < 0 || c[a] >= self.dims[a]) {
-            return false;
+    /// The ranges of photons in the rows of cells that meet the box of
+    /// half-width `r` around `x`, and their total length; `None` when there
+    /// are more than [`GRID_MAX_ROWS`] rows. The box is padded by a relative
+    /// 1e-5 so that rounding cannot leave out a photon at distance `r`.
+    fn rows(&self, x: Vec3, r: f32, rows: &mut [(u32, u32); GRID_MAX_ROWS]) -> Option<(usize, u32)> {
+        let pad = r * 1e-5 + (x - self.lo).abs().max_element() * 1e-6;
+        let lo = (x - (r + pad) - self.lo) * self.inv_cell;
+        let hi = (x + (r + pad) - self.lo) * self.inv_cell;
+        if !(lo.is_finite() && hi.is_finite()) {
+            return None;
         }
-        let i = self.index(c);
-        self.bits[i / 64] & (1 << (i % 64)) != 0
-    }
-
-    /// Whether a photon may lie within `r` of `x` (false only when none can).
-    fn may_hold(&self, x: Vec3, r: f32) -> bool {
-        if !(r <= self.cell) || !x.is_finite() {
-            return true;
+        let (mut a, mut b) = ([0i32; 3], [0i32; 3]);
+        for ax in 0..3 {
+            a[ax] = floor_i32(lo[ax]).max(0);
+            b[ax] = floor_i32(hi[ax]).min(self.dims[ax] - 1);
+            if a[ax] > b[ax] {
+                return Some((0, 0));
+            }
         }
-        let c = self.cell_of(x);
-        // The query's own cell first: where there are photons, it holds some.
-        if self.occupied(c) {
-            return true;
+        if ((b[1] - a[1] + 1) * (b[2] - a[2] + 1)) as usize > GRID_MAX_ROWS {
+            return None;
         }
-        (-1..=1).any(|dz| (-1..=1).any(|dy| (-1..=1).any(|dx| self.occupied([c[0] + dx, c[1] + dy, c[2] + dz]))))
+        let (mut n, mut total) = (0, 0);
+        for z in a[2]..=b[2] {
+            for y in a[1]..=b[1] {
+                let row = self.index([0, y, z]);
+                let (s, e) = (self.start[row + a[0] as usize], self.start[row + b[0] as usize + 1]);
+                if e > s {
+                    rows[n] = (s, e);
+                    n += 1;
+                    total += e - s;
+                }
+            }
+        }
+        Some((n, total))
     }
 }
 
-/// A photon map: the photons, a kd-tree over their positions, and a coarse
-/// occupancy grid that answers "nothing here" without the tree.
+/// A photon map: the photons, a kd-tree over their positions, and for maps
+/// read at visible surfaces a grid of the photons' cells ([`CellGrid`]).
+///
+/// A search within radius r finds exactly the photons whose distance from
+/// the query, computed from their stored positions, is at most r: the grid
+/// computes that distance itself, and the tree (which sees rotated
+/// positions, rounded differently) is asked a slightly wider radius and
+/// its answers are tested the same way. Every estimate is therefore the
+/// same whichever of the two answered it, with the grid or without.
 pub struct PhotonMap {
     photons: Vec<Photon>,
     tree: PointTree,
-    /// Consulted before the tree, when built ([`PhotonMap::with_occupancy`]).
-    occupancy: Option<Occupancy>,
+    grid: Option<CellGrid>,
+    /// How much farther than asked the tree searches: the rotation's
+    /// rounding moves a distance by far less.
+    tree_pad: f32,
 }
 
 /// The photons found for one estimate.
@@ -228,25 +294,39 @@ pub struct Gathered {
 }
 
 impl PhotonMap {
-    /// A map of `photons` (a pass's blocks, or one vector).
+    /// A map of `photons` (a pass's blocks, or one vector), searched by its
+    /// kd-tree alone.
     pub fn build(photons: impl Into<PhotonBlocks>) -> Self {
-        let photons = morton_sorted(&photons.into());
-        let tree = PointTree::build(photons.par_iter().map(|p| p.position()));
-        PhotonMap { photons, tree, occupancy: None }
+        Self::build_with_grid(photons, None)
     }
 
-    /// The same map with an occupancy grid for lookups with radius caps up
-    /// to `r_cap` (`None`: no grid). Either way every estimate is the same,
-    /// bit for bit: the grid only rejects lookups whose search sphere holds
-    /// no photon.
-    pub fn with_occupancy(mut self, r_cap: Option<f32>) -> Self {
-        self.occupancy = r_cap.and_then(|r| Occupancy::build(&self.photons, r));
+    /// A map whose lookups with radius caps up to `r_cap` read a grid of
+    /// cells first (`None`: the tree alone), its photons sorted by cell.
+    pub fn build_with_grid(photons: impl Into<PhotonBlocks>, r_cap: Option<f32>) -> Self {
+        let photons = morton_sorted(&photons.into());
+        let (grid, photons) = match r_cap {
+            Some(r) => CellGrid::build(photons, r / GRID_CELLS_PER_CAP),
+            None => (None, photons),
+        };
+        let tree = PointTree::build(photons.par_iter().map(|p| p.position()));
+        let (lo, hi) = bounds(photons.iter().map(Photon::position));
+        let reach = if photons.is_empty() { 0.0 } else { lo.abs().max(hi.abs()).max_element() };
+        PhotonMap { photons, tree, grid, tree_pad: reach * 1e-5 }
+    }
+
+    /// The same map, photons in the same order, searched by the tree alone:
+    /// every estimate is the same, bit for bit (the grid is a skip of work,
+    /// and this is the skip forced off).
+    pub fn without_grid(mut self) -> Self {
+        self.grid = None;
         self
     }
 
-    /// Whether a lookup at `x` with radius cap `r_max` can skip the tree.
+    /// Whether a lookup at `x` with radius cap `r_max` certainly finds no
+    /// photon (answered by the grid; without one, never).
     pub fn certainly_empty(&self, x: Vec3, r_max: f32) -> bool {
-        self.occupancy.as_ref().is_some_and(|g| !g.may_hold(x, r_max))
+        let mut rows = [(0, 0); GRID_MAX_ROWS];
+        self.grid.as_ref().is_some_and(|g| g.rows(x, r_max, &mut rows).is_some_and(|(_, total)| total == 0))
     }
 
     pub fn len(&self) -> usize {
@@ -261,15 +341,51 @@ impl PhotonMap {
         &self.photons
     }
 
-    /// Bytes held by the photons and the tree (an estimate of the tree part:
-    /// kiddo stores one f32 triple and one u32 per point, plus its stems).
+    /// Bytes held by the photons, the tree (an estimate: kiddo stores one
+    /// f32 triple and one u32 per point, plus its stems) and the grid.
     pub fn memory_bytes(&self) -> usize {
-        self.photons.len() * (std::mem::size_of::<Photon>() + 16)
+        self.photons.len() * (std::mem::size_of::<Photon>() + 16) + self.grid.as_ref().map_or(0, |g| g.start.len() * 4)
+    }
+
+    /// Pushes a [`found`] key for every photon within sqrt(`r2`) of `x`
+    /// (see [`PhotonMap`] for what "within" means). Returns whether they
+    /// are in index order (the grid finds them so; the tree in no set order).
+    fn within(&self, x: Vec3, r2: f32, buf: &mut Vec<u64>) -> bool {
+        let mut rows = [(0, 0); GRID_MAX_ROWS];
+        let r = r2.sqrt();
+        if let Some((n, total)) = self.grid.as_ref().and_then(|g| g.rows(x, r, &mut rows)) {
+            if total <= GRID_MAX_SCAN {
+                // Every candidate is written and the length advanced only
+                // for those inside: about a third are, a branch on it
+                // would be mispredicted often.
+                let mut len = buf.len();
+                buf.resize(len + total as usize, 0);
+                for &(s, e) in &rows[..n] {
+                    for (i, p) in (s..e).zip(&self.photons[s as usize..e as usize]) {
+                        let d2 = p.position().distance_squared(x);
+                        buf[len] = found(d2, i);
+                        len += (d2 <= r2) as usize;
+                    }
+                }
+                buf.truncate(len);
+                return true;
+            }
+        }
+        let wide = r + self.tree_pad + r * 1e-4;
+        self.tree.visit(x, wide * wide, |i| {
+            let d2 = self.photons[i as usize].position().distance_squared(x);
+            if d2 <= r2 {
+                buf.push(found(d2, i));
+            }
+        });
+        false
     }
 
     /// Finds the `k` nearest photons within `r_max` of `x` (fewer if fewer are
-    /// there) and leaves them in the scratch; the estimates keep those on a
-    /// surface facing like `n`.
+    /// there) and leaves them in the scratch in index order; the estimates
+    /// keep those on a surface facing like `n`, and sum them in that order,
+    /// which does not depend on the radius searched (hence not on the
+    /// thread's previous query) nor on whether the grid or the tree found them.
     /// The estimate's disk has the k-th photon on its rim, or radius `r_max`
     /// when fewer than `k` were found (a fixed-radius estimate). Photons on
     /// other surfaces (a wall in a corner) take part in fixing the radius but
@@ -277,34 +393,31 @@ impl PhotonMap {
     fn gather(&self, x: Vec3, k: usize, r_max: f32, scratch: &mut Scratch) -> Gathered {
         let r_max2 = r_max * r_max;
         if self.certainly_empty(x, r_max) {
-            // What the search below would conclude after descending the tree
-            // at growing radii: nothing, at the full radius.
+            // What the search below would conclude after searching at
+            // growing radii: nothing, at the full radius.
             scratch.buf.clear();
             scratch.hint_r2 = r_max2;
             return Gathered { r2: r_max2, count: 0 };
         }
-        let buf = &mut scratch.buf;
-        // Search a growing radius from the hint: the result is the same as one
-        // search at r_max, at the cost of the photons near the answer only.
-        // It must not depend on the hint (the thread's previous query), so
-        // a search whose k-th photon lies within 1e-4 of its rim is repeated
-        // wider, in case the tree's pruning, which rounds, kept or dropped a
-        // photon at the rim depending on the radius asked.
+        let Scratch { buf, select, .. } = scratch;
+        // Search a growing radius from the hint: the k nearest within the
+        // radius are the k nearest, whatever radius found them, so the
+        // result is that of one search at r_max, at the cost of the
+        // photons near the answer only.
         let mut r2 = if k > 0 && scratch.hint_r2 > 0.0 { scratch.hint_r2.min(r_max2) } else { r_max2 };
+        let mut ordered;
         let r2 = loop {
             buf.clear();
-            self.tree.within(x, r2, buf);
+            ordered = self.within(x, r2, buf);
             if k > 0 && buf.len() >= k {
-                // Photons at equal distances (f32 squares do tie, a few
-                // times per million estimates) are ranked by index.
-                buf.select_nth_unstable(k - 1);
-                buf.truncate(k);
-                let kth = unpack(buf[k - 1]).0;
-                if kth <= r2 * (1.0 - 1e-4) || r2 >= r_max2 {
-                    break kth;
-                }
-                r2 = (r2 * 1.5).min(r_max2);
-                continue;
+                // Keys rank photons at equal distances (f32 squares do tie,
+                // a few times per million estimates) by index: the k-th key
+                // and those below it are the k nearest.
+                select.clear();
+                select.extend_from_slice(buf);
+                let kth = *select.select_nth_unstable(k - 1).1;
+                buf.retain(|&key| key <= kth);
+                break unpack(kth).0;
             }
             if r2 >= r_max2 {
                 break r_max2;
@@ -314,10 +427,10 @@ impl PhotonMap {
             let grow = (1.3 * k as f32 / buf.len().max(1) as f32).clamp(1.5, 4.0);
             r2 = (r2 * grow).min(r_max2);
         };
+        if !ordered {
+            buf.sort_unstable_by_key(|&key| key as u32);
+        }
         scratch.hint_r2 = if r2 < r_max2 { r2 * 1.25 } else { r_max2 };
-        // The visit order depends on the radius searched, hence on the hint,
-        // hence on which thread ran the previous query: the estimates sum
-        // with `order_free_sum`, whose result does not depend on the order.
         Gathered { r2, count: buf.len() }
     }
 
@@ -338,15 +451,12 @@ impl PhotonMap {
             return (Color::ZERO, g.r2);
         }
         let on_rim_excluded = g.r2 < r_max * r_max;
-        buf.terms.clear();
-        buf.terms.extend(
-            buf.buf
-                .iter()
-                .map(|&key| unpack(key))
-                .filter(|&(d2, i)| (!on_rim_excluded || d2 < g.r2) && self.faces(i, n))
-                .map(|(_, i)| self.photons[i as usize].flux()),
-        );
-        let flux = order_free_sum(&buf.terms);
+        let mut flux = Color::ZERO;
+        for (d2, i) in buf.buf.iter().map(|&key| unpack(key)) {
+            if (!on_rim_excluded || d2 < g.r2) && self.faces(i, n) {
+                flux += self.photons[i as usize].flux();
+            }
+        }
         (flux / (PI * g.r2), g.r2)
     }
 
@@ -364,16 +474,14 @@ impl PhotonMap {
         if g.count == 0 || !(g.r2 > 0.0) {
             return ConeEstimate { weighted_flux: Color::ZERO, r2: g.r2 };
         }
-        let r = g.r2.sqrt();
-        buf.terms.clear();
-        buf.terms.extend(
-            buf.buf
-                .iter()
-                .map(|&key| unpack(key))
-                .filter(|&(_, i)| self.faces(i, n))
-                .map(|(d2, i)| self.photons[i as usize].flux() * (1.0 - d2.sqrt() / r).max(0.0)),
-        );
-        ConeEstimate { weighted_flux: order_free_sum(&buf.terms), r2: g.r2 }
+        let inv_r = 1.0 / g.r2.sqrt();
+        let mut weighted_flux = Color::ZERO;
+        for (d2, i) in buf.buf.iter().map(|&key| unpack(key)) {
+            if self.faces(i, n) {
+                weighted_flux += self.photons[i as usize].flux() * (1.0 - d2.sqrt() * inv_r).max(0.0);
+            }
+        }
+        ConeEstimate { weighted_flux, r2: g.r2 }
     }
 }
 
@@ -393,35 +501,6 @@ impl ConeEstimate {
         }
         rho / PI * self.weighted_flux * 3.0 / (PI * self.r2)
     }
-}
-
-/// The sum of non-negative, finite colours, the same whatever their order
-/// (floating-point addition is not associative; integer addition is): each
-/// term is scaled, per channel, to a 64-bit fixed-point number whose unit is
-/// set by the channel's largest term and the number of terms (neither
-/// depends on order), so the sum cannot overflow, then the terms are added
-/// exactly. The result keeps at least 40 bits relative to the largest term,
-/// more than an f32 holds.
-/// This replaces sorting the photons by index before summing, which cost a
-/// third of a caustic estimate.
-fn order_free_sum(terms: &[Color]) -> Color {
-    let max = terms.iter().fold(Color::ZERO, |m, c| m.max(*c));
-    // Terms below 2^(62 - n_bits) each keep the total below 2^62.
-    let n_bits = (usize::BITS - terms.len().leading_zeros()) as i32;
-    let scale = max.to_array().map(|m| {
-        if m > 0.0 && m.is_finite() {
-            2f64.powi(62 - n_bits - (m.log2().ceil() as i32 + 1))
-        } else {
-            0.0
-        }
-    });
-    let mut sum = [0i64; 3];
-    for c in terms {
-        for ch in 0..3 {
-            sum[ch] += (c[ch] as f64 * scale[ch]) as i64;
-        }
-    }
-    Color::from_array([0, 1, 2].map(|ch| if scale[ch] > 0.0 { (sum[ch] as f64 / scale[ch]) as f32 } else { 0.0 }))
 }
 
 /// Irradiance precomputed at a subset of the global photons (Christensen
@@ -697,30 +776,6 @@ impl IrradianceCache {
 mod tests {
     use super::*;
 
-    /// The estimates' sum gives the same bits in any order, and agrees with
-    /// an f64 sum to f32 precision, including terms spanning 30 octaves.
-    #[test]
-    fn order_free_sum_ignores_order_and_is_accurate() {
-        let mut rng = crate::sampling::stream(5, crate::sampling::Domain::Camera, 0);
-        for n in [1usize, 7, 100, 5000] {
-            let mut terms: Vec<Color> = (0..n)
-                .map(|_| {
-                    let u = crate::sampling::next_2d(&mut rng);
-                    Color::new(u.x, u.y * 1e-9, (u.x * 30.0).exp2() * 1e-6)
-                })
-                .collect();
-            let a = order_free_sum(&terms);
-            let exact: [f64; 3] = [0, 1, 2].map(|c| terms.iter().map(|t| t.to_array()[c] as f64).sum::<f64>());
-            for (c, want) in exact.iter().enumerate() {
-                let rel = (a[c] as f64 - want).abs() / want;
-                assert!(rel < 1e-6, "n {n} channel {c}: {} vs {want}", a[c]);
-            }
-            terms.reverse();
-            terms.rotate_left(n / 3);
-            assert_eq!(order_free_sum(&terms), a);
-        }
-        assert_eq!(order_free_sum(&[]), Color::ZERO);
-    }
     use crate::sampling::{next_2d, stream, Domain};
 
     /// Photons of equal power spread uniformly over a square: the estimates
@@ -802,6 +857,73 @@ mod tests {
         assert_eq!(backward, fresh);
         // Some estimates found fewer than k within the cap, some more.
         assert!(fresh.iter().any(|f| f.2 < 0.1 * 0.1) && fresh.iter().any(|f| f.2 == 0.1f32 * 0.1));
+    }
+
+    /// The grid's rows, the tree, and the two mixed (the tree answers where
+    /// rows hold too many photons) find exactly the k nearest that a brute
+    /// force over every photon finds, in any query order, and the estimates
+    /// sum them in the same order: the same bits.
+    #[test]
+    fn grid_and_tree_estimates_equal_brute_force() {
+        let mut rng = stream(15, Domain::Camera, 0);
+        // A sparse floor, a focus 400x denser on it, and a wall meeting it.
+        let photons: Vec<Photon> = (0..60_000)
+            .map(|i| {
+                let u = next_2d(&mut rng);
+                match i % 3 {
+                    0 => Photon::new(Vec3::new(4.0 * u.x, 0.0, 4.0 * u.y), Color::ONE, Vec3::Y),
+                    1 => Photon::new(Vec3::new(2.0 + 0.2 * u.x, 0.0, 2.0 + 0.2 * u.y), Color::splat(0.3), Vec3::Y),
+                    _ => Photon::new(Vec3::new(0.0, 4.0 * u.x, 4.0 * u.y), Color::splat(0.5), Vec3::X),
+                }
+            })
+            .collect();
+        let (k, r_max) = (50, 0.08);
+        let grid = PhotonMap::build_with_grid(photons.clone(), Some(r_max));
+        let tree = PhotonMap::build_with_grid(photons, Some(r_max)).without_grid();
+        assert!(grid.grid.is_some() && tree.grid.is_none());
+        // From the wall across the sparse floor into the focus and out.
+        let path: Vec<Vec3> =
+            (0..400).map(|i| Vec3::new(0.0001 + 0.006 * i as f32, 0.0, 0.5 + 0.0045 * i as f32)).collect();
+        let brute = |x: Vec3| {
+            let mut keys: Vec<u64> = (0..grid.len() as u32)
+                .map(|i| found(grid.photons()[i as usize].position().distance_squared(x), i))
+                .filter(|&key| unpack(key).0 <= r_max * r_max)
+                .collect();
+            keys.sort_unstable();
+            let r2 = if keys.len() >= k { unpack(keys[k - 1]).0 } else { r_max * r_max };
+            keys.truncate(k);
+            keys.sort_unstable_by_key(|&key| key as u32);
+            let inv_r = 1.0 / r2.sqrt();
+            let mut sum = Color::ZERO;
+            for (d2, i) in keys.iter().map(|&key| unpack(key)) {
+                if grid.faces(i, Vec3::Y) {
+                    sum += grid.photons()[i as usize].flux() * (1.0 - d2.sqrt() * inv_r).max(0.0);
+                }
+            }
+            (sum, r2)
+        };
+        let expected: Vec<(Color, f32)> = path.iter().map(|&x| brute(x)).collect();
+        let run = |map: &PhotonMap, order: &mut dyn Iterator<Item = usize>| {
+            let mut out = vec![(Color::ZERO, 0.0); path.len()];
+            let mut s = Scratch::default();
+            for i in order {
+                let e = map.cone_estimate(path[i], Vec3::Y, k, r_max, &mut s);
+                out[i] = (e.weighted_flux, e.r2);
+            }
+            out
+        };
+        for map in [&grid, &tree] {
+            assert_eq!(run(map, &mut (0..path.len())), expected);
+            assert_eq!(run(map, &mut (0..path.len()).rev()), expected);
+        }
+        // The path needed both the grid's rows and, in the focus, the tree.
+        let scanned = |&(x, (_, r2)): &(&Vec3, &(Color, f32))| {
+            grid.grid.as_ref().unwrap().rows(*x, r2.sqrt(), &mut [(0, 0); GRID_MAX_ROWS]).map(|(_, total)| total)
+        };
+        let totals: Vec<_> = path.iter().zip(&expected).map(|e| scanned(&e)).collect();
+        assert!(totals.iter().any(|t| t.is_some_and(|t| t > GRID_MAX_SCAN)), "no lookup went to the tree");
+        assert!(totals.iter().filter(|t| t.is_some_and(|t| t <= GRID_MAX_SCAN)).count() > 100);
+        assert!(expected.iter().any(|e| e.1 < r_max * r_max) && expected.iter().any(|e| e.1 == r_max * r_max));
     }
 
     #[test]
