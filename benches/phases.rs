@@ -37,7 +37,12 @@ fn kd_tree_build(c: &mut Criterion) {
 
 fn radiance_queries(c: &mut Criterion) {
     let scene = Scene::tncg15(Eye::One);
-    let caustic = PhotonMap::build(trace_pass(&scene, Pass::Caustic, 1_000_000, 1, &|_| {}).photons);
+    let caustic_photons = trace_pass(&scene, Pass::Caustic, 1_000_000, 1, &|_| {}).photons;
+    let r = 0.01 * scene.diagonal();
+    // The tree alone, and the map as a render builds it (the tree behind
+    // a grid of cells); the same estimates.
+    let caustic = PhotonMap::build(caustic_photons.clone());
+    let caustic_grid = PhotonMap::build_with_grid(caustic_photons, Some(r));
     let global = PhotonMap::build(trace_pass(&scene, Pass::Global, 200_000, 1, &|_| {}).photons);
     let cache = IrradianceCache::build(&global, 4, 100, 0.05 * scene.diagonal());
     // Query points: a line of floor points through the glass sphere's caustic.
@@ -46,11 +51,23 @@ fn radiance_queries(c: &mut Criterion) {
     let n = glam::Vec3::Z;
     let mut g = c.benchmark_group("radiance_queries");
     g.throughput(Throughput::Elements(queries.len() as u64));
-    let r = 0.01 * scene.diagonal();
-    g.bench_function("caustic_cone_k100", |b| {
+    for (name, map) in [("caustic_cone_k100", &caustic), ("caustic_cone_k100_grid", &caustic_grid)] {
+        g.bench_function(name, |b| {
+            let mut s = Scratch::default();
+            b.iter(|| queries.iter().map(|&x| map.radiance_cone(x, n, glam::Vec3::ONE, 100, r, &mut s).x).sum::<f32>())
+        });
+    }
+    // The caustic estimates of a render: at the first diffuse hits of
+    // 200 x 200 camera rays, in row order.
+    let hits = scene.diffuse_hits(200, 200);
+    g.throughput(Throughput::Elements(hits.len() as u64));
+    g.bench_function("caustic_cone_k100_grid_pixels", |b| {
         let mut s = Scratch::default();
-        b.iter(|| queries.iter().map(|&x| caustic.radiance_cone(x, n, glam::Vec3::ONE, 100, r, &mut s).x).sum::<f32>())
+        b.iter(|| {
+            hits.iter().map(|&(x, n)| caustic_grid.radiance_cone(x, n, glam::Vec3::ONE, 100, r, &mut s).x).sum::<f32>()
+        })
     });
+    g.throughput(Throughput::Elements(queries.len() as u64));
     g.bench_function("irradiance_cache_lookup", |b| {
         let mut s = Scratch::default();
         b.iter(|| queries.iter().map(|&x| cache.lookup(x, n, &mut s).x).sum::<f32>())
