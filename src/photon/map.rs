@@ -230,8 +230,14 @@ impl CellGrid {
         if photons.is_empty() || !(cell > 0.0) || !extent.is_finite() || !cell.is_finite() {
             return (None, photons);
         }
-        let cells = ((extent / cell).floor() + 1.0).element_product();
-        let cell = if cells > GRID_MAX_CELLS { cell * (cells / GRID_MAX_CELLS).cbrt() * 1.01 } else { cell };
+        // Widen the cells until the grid is small enough. (Scaling by the
+        // cube root of the excess undershoots on flat extents: a floor
+        // 1e5 wide with 5 mm cells would have kept 2e9 cells.)
+        let cells = |c: f32| ((extent / c).floor() + 1.0).element_product();
+        let mut cell = cell;
+        while cells(cell) > GRID_MAX_CELLS {
+            cell *= 1.25;
+        }
         let d = (extent / cell).as_ivec3() + 1;
         let mut grid = CellGrid { lo, inv_cell: 1.0 / cell, dims: [d.x, d.y, d.z], start: Vec::new() };
         // A counting sort: stable, so Morton order survives within cells.
@@ -937,6 +943,101 @@ mod tests {
         assert_eq!(kth_key(&[found(0.0, 3), found(0.0, 1)], 1, 0.0, &mut tmp), found(0.0, 1));
     }
 
+    /// The cone estimate of `map` at `x` (normal +y) from a sort of all its
+    /// photons by distance.
+    fn brute_cone(map: &PhotonMap, x: Vec3, k: usize, r_max: f32) -> (Color, f32) {
+        let mut keys: Vec<u64> = (0..map.len() as u32)
+            .map(|i| found(map.photons()[i as usize].position().distance_squared(x), i))
+            .filter(|&key| unpack(key).0 <= r_max * r_max)
+            .collect();
+        keys.sort_unstable();
+        let r2 = if k > 0 && keys.len() >= k { unpack(keys[k - 1]).0 } else { r_max * r_max };
+        if k > 0 {
+            keys.truncate(k);
+        }
+        keys.sort_unstable_by_key(|&key| key as u32);
+        if keys.is_empty() || !(r2 > 0.0) {
+            return (Color::ZERO, r2);
+        }
+        let inv_r = 1.0 / r2.sqrt();
+        let mut sum = Color::ZERO;
+        for (d2, i) in keys.iter().map(|&key| unpack(key)) {
+            if map.faces(i, Vec3::Y) {
+                sum += map.photons()[i as usize].flux() * (1.0 - d2.sqrt() * inv_r).max(0.0);
+            }
+        }
+        (sum, r2)
+    }
+
+    /// Asserts that both maps' cone estimates along `path`, forwards and
+    /// backwards with one scratch, equal the brute force's bits; returns
+    /// those.
+    fn same_as_brute_force(
+        grid: &PhotonMap,
+        tree: &PhotonMap,
+        path: &[Vec3],
+        k: usize,
+        r_max: f32,
+    ) -> Vec<(Color, f32)> {
+        let expected: Vec<(Color, f32)> = path.iter().map(|&x| brute_cone(grid, x, k, r_max)).collect();
+        let run = |map: &PhotonMap, order: &mut dyn Iterator<Item = usize>| {
+            let mut out = vec![(Color::ZERO, 0.0); path.len()];
+            let mut s = Scratch::default();
+            for i in order {
+                let e = map.cone_estimate(path[i], Vec3::Y, k, r_max, &mut s);
+                out[i] = (e.weighted_flux, e.r2);
+            }
+            out
+        };
+        for map in [grid, tree] {
+            assert_eq!(run(map, &mut (0..path.len())), expected);
+            assert_eq!(run(map, &mut (0..path.len()).rev()), expected);
+        }
+        expected
+    }
+
+    /// Layouts that stress the grid: every photon at one point, a single
+    /// photon, a floor so wide that the grid's cells are coarsened far past
+    /// the radius (every search goes to the tree), and photons far from the
+    /// origin, where a coordinate's last bit is a millimetre.
+    #[test]
+    fn grid_searches_equal_brute_force_on_degenerate_layouts() {
+        let mut rng = stream(17, Domain::Camera, 0);
+        let floor = |n: usize, origin: Vec3, side: f32, rng: &mut _| -> Vec<Photon> {
+            (0..n)
+                .map(|_| {
+                    let u = next_2d(rng);
+                    Photon::new(origin + Vec3::new(side * u.x, 0.0, side * u.y), Color::ONE, Vec3::Y)
+                })
+                .collect()
+        };
+        let at = Vec3::new(1.0, 2.0, 3.0);
+        let cases: Vec<(&str, Vec<Photon>, Vec3, f32)> = vec![
+            ("one point", vec![Photon::new(at, Color::ONE, Vec3::Y); 500], at, 0.1),
+            ("one photon", vec![Photon::new(at, Color::ONE, Vec3::Y)], at, 0.1),
+            ("wide floor", floor(20_000, Vec3::ZERO, 1e5, &mut rng), Vec3::new(5e4, 0.0, 5e4), 1e-2),
+            (
+                "far floor",
+                floor(20_000, Vec3::new(3e4, -2e4, 1e4), 4.0, &mut rng),
+                Vec3::new(3e4 + 2.0, -2e4, 1e4 + 2.0),
+                0.2,
+            ),
+        ];
+        for (name, photons, centre, r_max) in cases {
+            let grid = PhotonMap::build_with_grid(photons.clone(), Some(r_max));
+            let cells = grid.grid.as_ref().map_or(0, |g| g.start.len());
+            assert!(cells <= GRID_MAX_CELLS as usize + 1, "{name}: {cells} cells");
+            let tree = PhotonMap::build_with_grid(photons, Some(r_max)).without_grid();
+            let path: Vec<Vec3> = (0..40)
+                .map(|i| centre + Vec3::new(0.013 * r_max * (i as f32 - 20.0), 0.0, 0.007 * r_max * i as f32))
+                .collect();
+            for k in [0, 1, 20] {
+                let e = same_as_brute_force(&grid, &tree, &path, k, r_max);
+                assert!(e.iter().all(|(c, r2)| c.is_finite() && r2.is_finite()), "{name}");
+            }
+        }
+    }
+
     /// The grid's rows, the tree, and the two mixed (the tree answers where
     /// rows hold too many photons) find exactly the k nearest that a brute
     /// force over every photon finds, in any query order, and the estimates
@@ -962,38 +1063,7 @@ mod tests {
         // From the wall across the sparse floor into the focus and out.
         let path: Vec<Vec3> =
             (0..400).map(|i| Vec3::new(0.0001 + 0.006 * i as f32, 0.0, 0.5 + 0.0045 * i as f32)).collect();
-        let brute = |x: Vec3| {
-            let mut keys: Vec<u64> = (0..grid.len() as u32)
-                .map(|i| found(grid.photons()[i as usize].position().distance_squared(x), i))
-                .filter(|&key| unpack(key).0 <= r_max * r_max)
-                .collect();
-            keys.sort_unstable();
-            let r2 = if keys.len() >= k { unpack(keys[k - 1]).0 } else { r_max * r_max };
-            keys.truncate(k);
-            keys.sort_unstable_by_key(|&key| key as u32);
-            let inv_r = 1.0 / r2.sqrt();
-            let mut sum = Color::ZERO;
-            for (d2, i) in keys.iter().map(|&key| unpack(key)) {
-                if grid.faces(i, Vec3::Y) {
-                    sum += grid.photons()[i as usize].flux() * (1.0 - d2.sqrt() * inv_r).max(0.0);
-                }
-            }
-            (sum, r2)
-        };
-        let expected: Vec<(Color, f32)> = path.iter().map(|&x| brute(x)).collect();
-        let run = |map: &PhotonMap, order: &mut dyn Iterator<Item = usize>| {
-            let mut out = vec![(Color::ZERO, 0.0); path.len()];
-            let mut s = Scratch::default();
-            for i in order {
-                let e = map.cone_estimate(path[i], Vec3::Y, k, r_max, &mut s);
-                out[i] = (e.weighted_flux, e.r2);
-            }
-            out
-        };
-        for map in [&grid, &tree] {
-            assert_eq!(run(map, &mut (0..path.len())), expected);
-            assert_eq!(run(map, &mut (0..path.len()).rev()), expected);
-        }
+        let expected = same_as_brute_force(&grid, &tree, &path, k, r_max);
         // The path needed both the grid's rows and, in the focus, the tree.
         let scanned = |&(x, (_, r2)): &(&Vec3, &(Color, f32))| {
             grid.grid.as_ref().unwrap().rows(*x, r2.sqrt(), &mut [(0, 0); GRID_MAX_ROWS]).map(|(_, total)| total)
