@@ -240,22 +240,24 @@ impl CellGrid {
         }
         let d = (extent / cell).as_ivec3() + 1;
         let mut grid = CellGrid { lo, inv_cell: 1.0 / cell, dims: [d.x, d.y, d.z], start: Vec::new() };
-        // A counting sort: stable, so Morton order survives within cells.
+        // Sorted by (cell, position in Morton order): Morton order survives
+        // within cells, and the sort runs on every thread (a serial
+        // counting sort of the global map's 4.9 M photons took 0.3 s).
         let n_cells = (d.x * d.y * d.z) as usize;
-        let cell_of: Vec<u32> = photons.iter().map(|p| grid.index(grid.cell_of(p.position())) as u32).collect();
+        let mut keys: Vec<u64> = photons
+            .par_iter()
+            .enumerate()
+            .map(|(i, p)| ((grid.index(grid.cell_of(p.position())) as u64) << 32) | i as u64)
+            .collect();
+        keys.par_sort_unstable();
         let mut start = vec![0u32; n_cells + 1];
-        for &c in &cell_of {
-            start[c as usize + 1] += 1;
+        for &key in &keys {
+            start[(key >> 32) as usize + 1] += 1;
         }
         for c in 0..n_cells {
             start[c + 1] += start[c];
         }
-        let mut next = start.clone();
-        let mut sorted = vec![Photon::default(); photons.len()];
-        for (p, &c) in photons.iter().zip(&cell_of) {
-            sorted[next[c as usize] as usize] = *p;
-            next[c as usize] += 1;
-        }
+        let sorted: Vec<Photon> = keys.par_iter().map(|&key| photons[key as u32 as usize]).collect();
         grid.start = start;
         (Some(grid), sorted)
     }
