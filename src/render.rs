@@ -298,12 +298,12 @@ fn photon_pass(
 
     let t = Instant::now();
     // Caustic lookups run at every visible diffuse point and mostly near
-    // the radius cap: the grid serves them (and rejects empty regions);
-    // global-map lookups run at photons (the irradiance cache) and need no
-    // grid. The two builds at once: each has serial stretches the other
-    // can fill.
+    // the radius cap: the grid serves them (and rejects empty regions).
+    // Global-map lookups run at photons (the irradiance cache), at radii
+    // far below the cap: a finer grid serves most of them. The two builds
+    // at once: each has serial stretches the other can fill.
     let (global_map, caustic_map) = rayon::join(
-        || PhotonMap::build(global.photons),
+        || PhotonMap::build_with_grid(global.photons, Some(est.r_global * GLOBAL_GRID_FRACTION)),
         || {
             let map = PhotonMap::build_with_grid(caustic.photons, Some(est.r_caustic));
             if settings.skip {
@@ -324,6 +324,12 @@ fn photon_pass(
     stats.map_bytes = global_map.memory_bytes() + caustic_map.memory_bytes();
     Maps { caustic: caustic_map, cache }
 }
+
+/// The global map's grid is sized for the radius its estimates need (the
+/// k-th photon's distance, a few percent of the radius cap where photons
+/// are dense), not for the cap; the grid's cell budget widens it in a
+/// large scene.
+const GLOBAL_GRID_FRACTION: f32 = 0.05;
 
 /// The seed of pass `pass`: pass 0 uses the seed itself, so a one-pass
 /// progressive render is the classic render's photon set.

@@ -224,11 +224,13 @@ impl CellGrid {
     /// The grid for `photons` with cells `cell` wide (wider if the bounds
     /// would need too many), and the photons sorted by cell, keeping their
     /// order within a cell.
-    fn build(photons: Vec<Photon>, cell: f32) -> (Option<Self>, Vec<Photon>) {
+    /// Also returns, for each photon's place in the given order, its place
+    /// in the sorted one.
+    fn build(photons: &[Photon], cell: f32) -> Option<(Self, Vec<Photon>, Vec<u32>)> {
         let (lo, hi) = bounds(photons.iter().map(Photon::position));
         let extent = hi - lo;
         if photons.is_empty() || !(cell > 0.0) || !extent.is_finite() || !cell.is_finite() {
-            return (None, photons);
+            return None;
         }
         // Widen the cells until the grid is small enough. (Scaling by the
         // cube root of the excess undershoots on flat extents: a floor
@@ -258,8 +260,12 @@ impl CellGrid {
             start[c + 1] += start[c];
         }
         let sorted: Vec<Photon> = keys.par_iter().map(|&key| photons[key as u32 as usize]).collect();
+        let mut place = vec![0u32; keys.len()];
+        for (j, &key) in keys.iter().enumerate() {
+            place[key as u32 as usize] = j as u32;
+        }
         grid.start = start;
-        (Some(grid), sorted)
+        Some((grid, sorted, place))
     }
 
     /// The cell holding `x`, clamped to the grid.
@@ -322,6 +328,9 @@ impl CellGrid {
 pub struct PhotonMap {
     photons: Vec<Photon>,
     tree: PointTree,
+    /// Where the tree's items (places in Morton order) are in `photons`,
+    /// when the grid sorted them by cell.
+    tree_place: Option<Vec<u32>>,
     grid: Option<CellGrid>,
     /// How much farther than asked the tree searches: the rotation's
     /// rounding moves a distance by far less.
@@ -345,15 +354,33 @@ impl PhotonMap {
     /// A map whose lookups with radius caps up to `r_cap` read a grid of
     /// cells first (`None`: the tree alone), its photons sorted by cell.
     pub fn build_with_grid(photons: impl Into<PhotonBlocks>, r_cap: Option<f32>) -> Self {
-        let photons = morton_sorted(&photons.into());
-        let (grid, photons) = match r_cap {
-            Some(r) => CellGrid::build(photons, r / GRID_CELLS_PER_CAP),
-            None => (None, photons),
-        };
-        let tree = PointTree::build(photons.par_iter().map(|p| p.position()));
-        let (lo, hi) = bounds(photons.iter().map(Photon::position));
-        let reach = if photons.is_empty() { 0.0 } else { lo.abs().max(hi.abs()).max_element() };
-        PhotonMap { photons, tree, grid, tree_pad: reach * 1e-5 }
+        let morton = morton_sorted(&photons.into());
+        // The tree is built from the Morton order (kiddo builds twice as
+        // fast from spatially sorted points) while the grid sorts by cell.
+        let (tree, gridded) = rayon::join(
+            || PointTree::build(morton.par_iter().map(|p| p.position())),
+            || r_cap.and_then(|r| CellGrid::build(&morton, r / GRID_CELLS_PER_CAP)),
+        );
+        let (lo, hi) = bounds(morton.iter().map(Photon::position));
+        let reach = if morton.is_empty() { 0.0 } else { lo.abs().max(hi.abs()).max_element() };
+        let tree_pad = reach * 1e-5;
+        match gridded {
+            Some((grid, photons, place)) => {
+                PhotonMap { photons, tree, tree_place: Some(place), grid: Some(grid), tree_pad }
+            }
+            None => PhotonMap { photons: morton, tree, tree_place: None, grid: None, tree_pad },
+        }
+    }
+
+    /// The photon the tree knows as `item` (its place in Morton order).
+    #[inline]
+    fn tree_item(&self, item: u32) -> u32 {
+        self.tree_place.as_ref().map_or(item, |place| place[item as usize])
+    }
+
+    /// The photons in Morton order.
+    fn morton_order(&self) -> impl IndexedParallelIterator<Item = &Photon> + '_ {
+        (0..self.photons.len() as u32).into_par_iter().map(move |m| &self.photons[self.tree_item(m) as usize])
     }
 
     /// The same map, photons in the same order, searched by the tree alone:
@@ -386,7 +413,9 @@ impl PhotonMap {
     /// Bytes held by the photons, the tree (an estimate: kiddo stores one
     /// f32 triple and one u32 per point, plus its stems) and the grid.
     pub fn memory_bytes(&self) -> usize {
-        self.photons.len() * (std::mem::size_of::<Photon>() + 16) + self.grid.as_ref().map_or(0, |g| g.start.len() * 4)
+        self.photons.len() * (std::mem::size_of::<Photon>() + 16)
+            + self.grid.as_ref().map_or(0, |g| g.start.len() * 4)
+            + self.tree_place.as_ref().map_or(0, |p| p.len() * 4)
     }
 
     /// Writes a [`found`] key for every photon within sqrt(`r2`) of `x`
@@ -422,7 +451,8 @@ impl PhotonMap {
         }
         let wide = r + self.tree_pad + r * 1e-4;
         let mut len = 0;
-        self.tree.visit(x, wide * wide, |i| {
+        self.tree.visit(x, wide * wide, |item| {
+            let i = self.tree_item(item);
             let d2 = self.photons[i as usize].position().distance_squared(x);
             if d2 <= r2 {
                 if len < buf.len() {
@@ -691,9 +721,10 @@ impl IrradianceCache {
             .photons
             .get(map.len() / 2)
             .map_or(0.0, |p| map.irradiance(p.position(), p.surface_normal(), k, r_max, &mut Scratch::default()).1);
+        // Every stride-th photon along the Morton order: spread evenly over
+        // the surfaces whatever order the map keeps its photons in.
         let computed: Vec<(CachePoint, f32)> = map
-            .photons
-            .par_iter()
+            .morton_order()
             .step_by(stride)
             .map_init(
                 || Scratch::with_hint(hint),
@@ -1074,6 +1105,39 @@ mod tests {
         assert!(totals.iter().any(|t| t.is_some_and(|t| t > GRID_MAX_SCAN)), "no lookup went to the tree");
         assert!(totals.iter().filter(|t| t.is_some_and(|t| t <= GRID_MAX_SCAN)).count() > 100);
         assert!(expected.iter().any(|e| e.1 < r_max * r_max) && expected.iter().any(|e| e.1 == r_max * r_max));
+    }
+
+    /// A map sorted by the grid's cells computes its cache at the same
+    /// photons (every stride-th along the Morton order) and finds the same
+    /// irradiance there (its sums run in another order: last bits only).
+    #[test]
+    fn irradiance_cache_is_the_same_with_a_grid() {
+        let mut rng = stream(18, Domain::Camera, 0);
+        let photons: Vec<Photon> = (0..50_000)
+            .map(|i| {
+                let u = next_2d(&mut rng) * 4.0;
+                match i % 2 {
+                    0 => Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y),
+                    _ => Photon::new(Vec3::new(0.0, u.x, u.y), Color::splat(0.5), Vec3::X),
+                }
+            })
+            .collect();
+        let plain = IrradianceCache::build(&PhotonMap::build(photons.clone()), 4, 50, 1.0);
+        let gridded_map = PhotonMap::build_with_grid(photons, Some(0.05));
+        assert!(gridded_map.grid.is_some());
+        let gridded = IrradianceCache::build(&gridded_map, 4, 50, 1.0);
+        let key = |c: &CachePoint| c.position.map(f32::to_bits);
+        let (mut a, mut b) = (plain.points.clone(), gridded.points.clone());
+        a.sort_by_key(key);
+        b.sort_by_key(key);
+        assert_eq!(a.len(), b.len());
+        for (p, q) in a.iter().zip(&b) {
+            assert_eq!(p.position, q.position);
+            for c in 0..3 {
+                let (x, y) = (p.irradiance[c], q.irradiance[c]);
+                assert!((x - y).abs() <= 1e-5 * x.abs().max(1e-30), "{x} vs {y}");
+            }
+        }
     }
 
     #[test]
