@@ -152,7 +152,7 @@ pub struct Stats {
     pub edge_pixels: usize,
     pub first_nonfinite: Option<(u64, &'static str)>,
     pub photon_time: Duration,
-    /// The map build: kd-trees (Morton sort, trees, the caustic map's grid), then
+    /// The map build: kd-trees (Morton sort, trees, the maps' grids), then
     /// the irradiance cache (estimates at photons, their grid and tree).
     pub tree_time: Duration,
     pub cache_time: Duration,

@@ -5,9 +5,9 @@
 //! on axis-aligned walls share one coordinate exactly, which makes kd-tree
 //! splits degenerate and queries slow (shared/research/ecosystem.md §2);
 //! distances are unchanged by a rotation. Photons are stored in Morton order
-//! so that neighbours in space are neighbours in memory; a map read at
-//! visible surfaces (the caustic map) is then sorted by the cells of a
-//! uniform grid, through which most of its lookups go instead of the tree.
+//! so that neighbours in space are neighbours in memory; the renderer's maps
+//! are then sorted by the cells of a uniform grid sized for their lookups,
+//! through which most lookups go instead of the tree.
 
 use super::{quantize_normal, Photon, PhotonBlocks};
 use crate::math::{floor_i32, Color};
@@ -74,8 +74,8 @@ const KTH_BUCKETS: usize = 64;
 /// `r2`; 1 <= k <= keys.len()), without reordering them: a histogram of the
 /// squared distances (uniform for photons on a surface, so each bucket
 /// holds a few) finds the bucket holding it, and a selection among that
-/// bucket's keys (copied to `tmp`) finds it there. Twice as fast as a
-/// selection over a copy of all of them.
+/// bucket's keys (copied to `tmp`) finds it there. (Measured no faster
+/// than a selection over a copy of all of them; it leaves them in order.)
 fn kth_key(keys: &[u64], k: usize, r2: f32, tmp: &mut Vec<u64>) -> u64 {
     debug_assert!(k >= 1 && k <= keys.len());
     tmp.clear();
@@ -191,12 +191,12 @@ fn morton_sorted(photons: &PhotonBlocks) -> Vec<Photon> {
 
 /// A uniform grid over the map's bounds whose cells hold contiguous ranges
 /// of the photons (sorted by cell, rows along x, so a row of cells is one
-/// range). A lookup near the radius cap reads a few rows of photons in
-/// memory order instead of descending the kd-tree: the caustic estimates
-/// are mostly sparse (77% need more than half the cap), where a tree
-/// search visits many leaves for ~100 photons. Where the rows hold too many
-/// photons (the caustic's focus) the tree answers. A lookup whose rows are
-/// all empty finds nothing without either.
+/// range). A lookup reads a few rows of photons in memory order instead of
+/// descending the kd-tree, which visits many leaves for ~100 photons (77%
+/// of the caustic estimates need more than half the cap; the global map's
+/// cells are sized for its much smaller radii). Where the rows hold too
+/// many photons (the caustic's focus) the tree answers. A lookup whose
+/// rows are all empty finds nothing without either.
 struct CellGrid {
     lo: Vec3,
     inv_cell: f32,
@@ -316,8 +316,8 @@ impl CellGrid {
     }
 }
 
-/// A photon map: the photons, a kd-tree over their positions, and for maps
-/// read at visible surfaces a grid of the photons' cells ([`CellGrid`]).
+/// A photon map: the photons, a kd-tree over their positions, and, when
+/// built with one, a grid of the photons' cells (`CellGrid`).
 ///
 /// A search within radius r finds exactly the photons whose distance from
 /// the query, computed from their stored positions, is at most r: the grid
@@ -434,8 +434,8 @@ impl PhotonMap {
                         buf.resize(total as usize, 0);
                     }
                     // Every candidate is written and the count advanced
-                    // only for those inside: about a third are, and a
-                    // branch on it would be mispredicted often.
+                    // only for those inside: many are not, and a branch on
+                    // it would be mispredicted often.
                     let mut len = 0;
                     for &(s, e) in &rows[..n] {
                         for (i, p) in (s..e).zip(&self.photons[s as usize..e as usize]) {
