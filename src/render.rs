@@ -303,7 +303,7 @@ fn photon_pass(
     // far below the cap: a finer grid serves most of them. The two builds
     // at once: each has serial stretches the other can fill.
     let (global_map, caustic_map) = rayon::join(
-        || PhotonMap::build_with_grid(global.photons, Some(est.r_global * GLOBAL_GRID_FRACTION)),
+        || PhotonMap::build_for_photon_lookups(global.photons, est.r_global * GLOBAL_GRID_CELL),
         || {
             let map = PhotonMap::build_with_grid(caustic.photons, Some(est.r_caustic));
             if settings.skip {
@@ -325,11 +325,12 @@ fn photon_pass(
     Maps { caustic: caustic_map, cache }
 }
 
-/// The global map's grid is sized for the radius its estimates need (the
-/// k-th photon's distance, a few percent of the radius cap where photons
-/// are dense), not for the cap; the grid's cell budget widens it in a
-/// large scene.
-const GLOBAL_GRID_FRACTION: f32 = 0.05;
+/// The global map's grid cells, as a fraction of its radius cap: sized
+/// for the radius its estimates need (the k-th photon's distance, a few
+/// percent of the cap where photons are dense), not for the cap. The
+/// grid's cell budget widens them in a large scene, and where photons are
+/// so dense that searches would read too many the map goes without.
+const GLOBAL_GRID_CELL: f32 = 0.025;
 
 /// The seed of pass `pass`: pass 0 uses the seed itself, so a one-pass
 /// progressive render is the classic render's photon set.

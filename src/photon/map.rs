@@ -226,7 +226,9 @@ impl CellGrid {
     /// order within a cell.
     /// Also returns, for each photon's place in the given order, its place
     /// in the sorted one.
-    fn build(photons: &[Photon], cell: f32) -> Option<(Self, Vec<Photon>, Vec<u32>)> {
+    /// With `at_photons` (a map searched only at its own photons), no grid
+    /// where it would not pay.
+    fn build(photons: &[Photon], cell: f32, at_photons: bool) -> Option<(Self, Vec<Photon>, Vec<u32>)> {
         let (lo, hi) = bounds(photons.iter().map(Photon::position));
         let extent = hi - lo;
         if photons.is_empty() || !(cell > 0.0) || !extent.is_finite() || !cell.is_finite() {
@@ -246,16 +248,27 @@ impl CellGrid {
         // within cells, and the sort runs on every thread (a serial
         // counting sort of the global map's 4.9 M photons took 0.3 s).
         let n_cells = (d.x * d.y * d.z) as usize;
-        let mut keys: Vec<u64> = photons
-            .par_iter()
-            .enumerate()
-            .map(|(i, p)| ((grid.index(grid.cell_of(p.position())) as u64) << 32) | i as u64)
-            .collect();
-        keys.par_sort_unstable();
+        let cell_index: Vec<u32> = photons.par_iter().map(|p| grid.index(grid.cell_of(p.position())) as u32).collect();
         let mut start = vec![0u32; n_cells + 1];
-        for &key in &keys {
-            start[(key >> 32) as usize + 1] += 1;
+        for &c in &cell_index {
+            start[c as usize + 1] += 1;
         }
+        if at_photons {
+            // Searches at the photons themselves read, around a photon's
+            // own cell, a few cells like it: where a photon's cell holds
+            // GRID_MAX_SCAN / 9 photons on average, most would go to the
+            // tree anyway (the global map at 1e7 photons), and the grid
+            // would cost its sort and memory for nothing.
+            let typical =
+                cell_index.par_iter().map(|&c| start[c as usize + 1] as f64).sum::<f64>() / photons.len() as f64;
+            if 9.0 * typical > GRID_MAX_SCAN as f64 {
+                return None;
+            }
+        }
+        let mut keys: Vec<u64> =
+            cell_index.par_iter().enumerate().map(|(i, &c)| ((c as u64) << 32) | i as u64).collect();
+        drop(cell_index);
+        keys.par_sort_unstable();
         for c in 0..n_cells {
             start[c + 1] += start[c];
         }
@@ -354,12 +367,24 @@ impl PhotonMap {
     /// A map whose lookups with radius caps up to `r_cap` read a grid of
     /// cells first (`None`: the tree alone), its photons sorted by cell.
     pub fn build_with_grid(photons: impl Into<PhotonBlocks>, r_cap: Option<f32>) -> Self {
-        let morton = morton_sorted(&photons.into());
+        Self::build_gridded(photons.into(), r_cap.map(|r| r / GRID_CELLS_PER_CAP), false)
+    }
+
+    /// A map searched only at its own photons (the irradiance cache's
+    /// estimates), with a grid of cells `cell` wide where the photons are
+    /// sparse enough for it to pay, else the tree alone.
+    pub fn build_for_photon_lookups(photons: impl Into<PhotonBlocks>, cell: f32) -> Self {
+        Self::build_gridded(photons.into(), Some(cell), true)
+    }
+
+    fn build_gridded(photons: PhotonBlocks, cell: Option<f32>, at_photons: bool) -> Self {
+        let morton = morton_sorted(&photons);
+        drop(photons);
         // The tree is built from the Morton order (kiddo builds twice as
         // fast from spatially sorted points) while the grid sorts by cell.
         let (tree, gridded) = rayon::join(
             || PointTree::build(morton.par_iter().map(|p| p.position())),
-            || r_cap.and_then(|r| CellGrid::build(&morton, r / GRID_CELLS_PER_CAP)),
+            || cell.and_then(|c| CellGrid::build(&morton, c, at_photons)),
         );
         let (lo, hi) = bounds(morton.iter().map(Photon::position));
         let reach = if morton.is_empty() { 0.0 } else { lo.abs().max(hi.abs()).max_element() };
@@ -1105,6 +1130,27 @@ mod tests {
         assert!(totals.iter().any(|t| t.is_some_and(|t| t > GRID_MAX_SCAN)), "no lookup went to the tree");
         assert!(totals.iter().filter(|t| t.is_some_and(|t| t <= GRID_MAX_SCAN)).count() > 100);
         assert!(expected.iter().any(|e| e.1 < r_max * r_max) && expected.iter().any(|e| e.1 == r_max * r_max));
+    }
+
+    /// A map searched at its photons keeps its grid only where a photon's
+    /// cell and its neighbours hold few enough to scan.
+    #[test]
+    fn photon_lookup_maps_keep_a_grid_only_where_it_pays() {
+        let mut rng = stream(19, Domain::Camera, 0);
+        let photons: Vec<Photon> = (0..50_000)
+            .map(|_| {
+                let u = next_2d(&mut rng) * 4.0;
+                Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y)
+            })
+            .collect();
+        // ~8 photons per 5 cm cell: kept. ~3,000 per 1 m cell: dropped.
+        let fine = PhotonMap::build_for_photon_lookups(photons.clone(), 0.05);
+        let coarse = PhotonMap::build_for_photon_lookups(photons, 1.0);
+        assert!(fine.grid.is_some() && coarse.grid.is_none());
+        let path: Vec<Vec3> = (0..30).map(|i| Vec3::new(0.1 * i as f32 + 0.5, 0.0, 2.0)).collect();
+        for map in [&fine, &coarse] {
+            same_as_brute_force(map, map, &path, 30, 0.5);
+        }
     }
 
     /// A map sorted by the grid's cells computes its cache at the same
