@@ -1132,17 +1132,23 @@ mod tests {
         assert!(expected.iter().any(|e| e.1 < r_max * r_max) && expected.iter().any(|e| e.1 == r_max * r_max));
     }
 
-    /// A map searched at its photons keeps its grid only where a photon's
-    /// cell and its neighbours hold few enough to scan.
-    #[test]
-    fn photon_lookup_maps_keep_a_grid_only_where_it_pays() {
-        let mut rng = stream(19, Domain::Camera, 0);
-        let photons: Vec<Photon> = (0..50_000)
+    /// `n` photons of power 1 spread uniformly over the square [0, 4]^2 of
+    /// the plane y = 0, facing +y (random stream `seed`).
+    fn uniform_floor(seed: u64, n: usize) -> Vec<Photon> {
+        let mut rng = stream(seed, Domain::Camera, 0);
+        (0..n)
             .map(|_| {
                 let u = next_2d(&mut rng) * 4.0;
                 Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y)
             })
-            .collect();
+            .collect()
+    }
+
+    /// A map searched at its photons keeps its grid only where a photon's
+    /// cell and its neighbours hold few enough to scan.
+    #[test]
+    fn photon_lookup_maps_keep_a_grid_only_where_it_pays() {
+        let photons = uniform_floor(19, 50_000);
         // ~8 photons per 5 cm cell: kept. ~3,000 per 1 m cell: dropped.
         let fine = PhotonMap::build_for_photon_lookups(photons.clone(), 0.05);
         let coarse = PhotonMap::build_for_photon_lookups(photons, 1.0);
@@ -1188,13 +1194,7 @@ mod tests {
 
     #[test]
     fn irradiance_cache_agrees_with_direct_estimate() {
-        let mut rng = stream(12, Domain::Camera, 0);
-        let photons: Vec<Photon> = (0..100_000)
-            .map(|_| {
-                let u = next_2d(&mut rng) * 4.0;
-                Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y)
-            })
-            .collect();
+        let photons = uniform_floor(12, 100_000);
         let map = PhotonMap::build(photons);
         let cache = IrradianceCache::build(&map, 4, 100, 1.0);
         assert_eq!(cache.len(), 25_000);
