@@ -67,38 +67,6 @@ fn unpack(key: u64) -> (f32, u32) {
     (f32::from_bits((key >> 32) as u32), key as u32)
 }
 
-/// Buckets of [`kth_key`]'s histogram.
-const KTH_BUCKETS: usize = 64;
-
-/// The `k`-th smallest of `keys` ([`found`] keys within squared radius
-/// `r2`; 1 <= k <= keys.len()), without reordering them: a histogram of the
-/// squared distances (uniform for photons on a surface, so each bucket
-/// holds a few) finds the bucket holding it, and a selection among that
-/// bucket's keys (copied to `tmp`) finds it there. (Measured no faster
-/// than a selection over a copy of all of them; it leaves them in order.)
-fn kth_key(keys: &[u64], k: usize, r2: f32, tmp: &mut Vec<u64>) -> u64 {
-    debug_assert!(k >= 1 && k <= keys.len());
-    tmp.clear();
-    let scale = KTH_BUCKETS as f32 / r2;
-    if !(scale.is_finite() && scale > 0.0) {
-        tmp.extend_from_slice(keys);
-        return *tmp.select_nth_unstable(k - 1).1;
-    }
-    // Monotonic in the distance: a key in a lower bucket is smaller.
-    let bucket = |key: u64| ((unpack(key).0 * scale) as usize).min(KTH_BUCKETS - 1);
-    let mut count = [0u32; KTH_BUCKETS];
-    for &key in keys {
-        count[bucket(key)] += 1;
-    }
-    let (mut b, mut below) = (0, 0);
-    while below + (count[b] as usize) < k {
-        below += count[b] as usize;
-        b += 1;
-    }
-    tmp.extend(keys.iter().copied().filter(|&key| bucket(key) == b));
-    *tmp.select_nth_unstable(k - 1 - below).1
-}
-
 /// A kd-tree over points, with the rotation applied on the way in.
 struct PointTree {
     tree: Option<ImmutableKdTree<f32, 3>>,
@@ -221,15 +189,19 @@ const GRID_MAX_ROWS: usize = 64;
 const GRID_MAX_SCAN: u32 = 2048;
 
 impl CellGrid {
-    /// The grid for `photons` with cells `cell` wide (wider if the bounds
-    /// would need too many), and the photons sorted by cell, keeping their
+    /// The grid for `photons` (within bounds `(lo, hi)`) with cells `cell`
+    /// wide (wider if the bounds would need too many), and the photons sorted by cell, keeping their
     /// order within a cell.
     /// Also returns, for each photon's place in the given order, its place
     /// in the sorted one.
     /// With `at_photons` (a map searched only at its own photons), no grid
     /// where it would not pay.
-    fn build(photons: &[Photon], cell: f32, at_photons: bool) -> Option<(Self, Vec<Photon>, Vec<u32>)> {
-        let (lo, hi) = bounds(photons.iter().map(Photon::position));
+    fn build(
+        photons: &[Photon],
+        (lo, hi): (Vec3, Vec3),
+        cell: f32,
+        at_photons: bool,
+    ) -> Option<(Self, Vec<Photon>, Vec<u32>)> {
         let extent = hi - lo;
         if photons.is_empty() || !(cell > 0.0) || !extent.is_finite() || !cell.is_finite() {
             return None;
@@ -382,11 +354,11 @@ impl PhotonMap {
         drop(photons);
         // The tree is built from the Morton order (kiddo builds twice as
         // fast from spatially sorted points) while the grid sorts by cell.
+        let (lo, hi) = bounds(morton.iter().map(Photon::position));
         let (tree, gridded) = rayon::join(
             || PointTree::build(morton.par_iter().map(|p| p.position())),
-            || cell.and_then(|c| CellGrid::build(&morton, c, at_photons)),
+            || cell.and_then(|c| CellGrid::build(&morton, (lo, hi), c, at_photons)),
         );
-        let (lo, hi) = bounds(morton.iter().map(Photon::position));
         let reach = if morton.is_empty() { 0.0 } else { lo.abs().max(hi.abs()).max_element() };
         let tree_pad = reach * 1e-5;
         match gridded {
@@ -515,9 +487,11 @@ impl PhotonMap {
             if k > 0 && count >= k {
                 // Keys rank photons at equal distances (f32 squares do tie,
                 // a few times per million estimates) by index: the k-th key
-                // and those below it are the k nearest. Kept in place, in
-                // their order, without a branch on each.
-                let kth = kth_key(&buf[..count], k, r2, select);
+                // and those below it are the k nearest, selected in a copy
+                // and kept in place, in their order, without a branch on each.
+                select.clear();
+                select.extend_from_slice(&buf[..count]);
+                let kth = *select.select_nth_unstable(k - 1).1;
                 let mut kept = 0;
                 for j in 0..count {
                     let key = buf[j];
@@ -967,38 +941,6 @@ mod tests {
         assert_eq!(backward, fresh);
         // Some estimates found fewer than k within the cap, some more.
         assert!(fresh.iter().any(|f| f.2 < 0.1 * 0.1) && fresh.iter().any(|f| f.2 == 0.1f32 * 0.1));
-    }
-
-    /// The histogram selection finds the k-th key a sort finds, with keys
-    /// tied in distance, at zero and on the rim, and bunched in one bucket.
-    #[test]
-    fn kth_key_matches_sorting() {
-        let mut rng = stream(16, Domain::Camera, 0);
-        let mut tmp = Vec::new();
-        for n in [1usize, 2, 7, 100, 130, 400, 2000] {
-            let r2 = 0.37f32;
-            for spread in [1.0f32, 1e-3] {
-                let keys: Vec<u64> = (0..n as u32)
-                    .map(|i| {
-                        let u = next_2d(&mut rng);
-                        let d2 = match i % 7 {
-                            0 => 0.0,
-                            1 => r2,
-                            2 => 0.125 * r2,
-                            _ => u.x * r2 * spread,
-                        };
-                        found(d2, i * 31 % 1009)
-                    })
-                    .collect();
-                let mut sorted = keys.clone();
-                sorted.sort_unstable();
-                for k in [1, n / 3 + 1, n / 2 + 1, n] {
-                    assert_eq!(kth_key(&keys, k, r2, &mut tmp), sorted[k - 1], "n {n} k {k} spread {spread}");
-                }
-            }
-        }
-        // A radius of zero falls back to a plain selection.
-        assert_eq!(kth_key(&[found(0.0, 3), found(0.0, 1)], 1, 0.0, &mut tmp), found(0.0, 1));
     }
 
     /// The cone estimate of `map` at `x` (normal +y) from a sort of all its
