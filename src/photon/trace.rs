@@ -71,17 +71,8 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
         // the next block starts in a fresh one of that capacity, whose pages
         // are faulted in only as photons are written.
         .map_init(Vec::new, |out: &mut Vec<Photon>, b| {
-            let mut block_rays = 0;
-            let mut block_first = 0;
-            for i in b * BLOCK..((b + 1) * BLOCK).min(n) {
-                let mut rng = stream(seed, domain, i);
-                let Some((ray, departure, power)) = emit(scene, pass, n, &mut rng) else {
-                    continue;
-                };
-                let r = follow(scene, pass, ray, departure, power, &mut rng, out);
-                block_rays += r.rays;
-                block_first += r.first_hit_specular as u64;
-            }
+            let (block_rays, block_first) =
+                trace_range(scene, pass, n, seed, domain, b * BLOCK..((b + 1) * BLOCK).min(n), out);
             rays.fetch_add(block_rays, Ordering::Relaxed);
             first_specular.fetch_add(block_first, Ordering::Relaxed);
             on_block(((b + 1) * BLOCK).min(n) - b * BLOCK);
@@ -190,129 +181,177 @@ fn cone_towards(from: Vec3, center: Vec3, radius: f32) -> (Vec3, f32) {
     (d / dist2.sqrt(), (1.0 - sin2).max(0.0).sqrt())
 }
 
-struct Followed {
-    rays: u64,
-    first_hit_specular: bool,
+/// One photon on its way: what the next segment needs.
+struct Path {
+    ray: Ray,
+    departure: Option<Departure>,
+    power: Color,
+    rng: Rng,
+    bounce: u32,
+    specular_bounces: u32,
+    only_specular_so_far: bool,
 }
 
-/// Follows one photon until it is absorbed, escapes or is stored for the last time.
-fn follow(
+/// Photons one thread carries at once. Each segment of a path waits on the
+/// one before it (the hit, then the sampled direction, then the offset
+/// origin); segments of different photons do not, so the processor can
+/// overlap them when they are traced round-robin.
+const LANES: usize = 2;
+
+/// Traces photons `range` of `pass`, `LANES` at a time, storing into `out`.
+/// Returns (rays cast, photons whose first hit was specular).
+fn trace_range(
     scene: &Scene,
     pass: Pass,
-    mut ray: Ray,
-    mut departure: Option<Departure>,
-    mut power: Color,
-    rng: &mut Rng,
+    n: u64,
+    seed: u64,
+    domain: Domain,
+    range: std::ops::Range<u64>,
     out: &mut Vec<Photon>,
-) -> Followed {
-    let mut only_specular_so_far = true;
-    let mut specular_bounces = 0u32;
-    let mut result = Followed { rays: 0, first_hit_specular: false };
-    for bounce in 0..MAX_BOUNCES {
-        result.rays += 1;
-        let Some(hit) = scene.intersect(&ray, departure) else {
-            break;
-        };
-        power *= scene.transmittance(departure, hit.t);
-        let n = hit.facing_normal(ray.dir);
-        let material = *scene.material(hit.prim);
-        if bounce == 0 {
-            result.first_hit_specular = material.is_specular();
+) -> (u64, u64) {
+    let mut next = range.start;
+    let mut rays = 0;
+    let mut first = 0;
+    // The next photon of the range that leaves its light.
+    let start = |next: &mut u64| -> Option<Path> {
+        while *next < range.end {
+            let mut rng = stream(seed, domain, *next);
+            *next += 1;
+            if let Some((ray, departure, power)) = emit(scene, pass, n, &mut rng) {
+                return Some(Path { ray, departure, power, rng, bounce: 0, specular_bounces: 0, only_specular_so_far: true });
+            }
         }
-        let frame = Frame::from_normal(n);
-        let wi = frame.to_local(-ray.dir);
-        let wo = match material {
-            Material::Lambertian { rho } => {
-                match pass {
-                    // Light reaching a diffuse surface straight from the light is
-                    // not a caustic (shadow rays count it); after a diffuse
-                    // bounce it is indirect light (final gathering counts it).
-                    Pass::Caustic => {
-                        if only_specular_so_far && specular_bounces > 0 && max_component(rho) > 0.0 {
-                            out.push(Photon::new(hit.point, power, n));
-                        }
-                        break;
-                    }
-                    Pass::Global => {
-                        if max_component(rho) > 0.0 {
-                            out.push(Photon::new(hit.point, power, n));
-                        }
-                    }
-                }
-                // Russian roulette with the albedo: survivors carry power * rho / p.
-                let p = max_component(rho);
-                if !(rng.random::<f32>() < p) {
-                    break;
-                }
-                power *= rho / p;
-                only_specular_so_far = false;
-                cosine_hemisphere(next_2d(rng))
+        None
+    };
+    let mut lanes: [Option<Path>; LANES] = std::array::from_fn(|_| start(&mut next));
+    loop {
+        let mut alive = false;
+        for lane in lanes.iter_mut() {
+            let Some(path) = lane else { continue };
+            alive = true;
+            rays += 1;
+            let (go_on, first_specular) = step(scene, pass, path, out);
+            first += first_specular as u64;
+            if !go_on {
+                *lane = start(&mut next);
             }
-            Material::Phong(p) => {
-                // The Lambertian lobe stores photons as a Lambertian surface
-                // does; roulette then picks the lobe that carries the photon on.
-                let rho = p.diffuse_rho();
-                let store = max_component(rho) > 0.0;
-                match pass {
-                    Pass::Caustic if store && only_specular_so_far && specular_bounces > 0 => {
-                        out.push(Photon::new(hit.point, power, n));
-                    }
-                    Pass::Global if store => out.push(Photon::new(hit.point, power, n)),
-                    _ => {}
-                }
-                let Some((lobe, prob)) = p.choose_lobe(rng.random::<f32>()) else {
-                    break;
-                };
-                match lobe {
-                    Lobe::Mirror => {
-                        power *= p.mirror_rho() / prob;
-                        specular_bounces += 1;
-                        reflect(wi)
-                    }
-                    // A caustic path ends at its first non-specular bounce.
-                    _ if pass == Pass::Caustic => break,
-                    Lobe::Diffuse => {
-                        power *= rho / prob;
-                        only_specular_so_far = false;
-                        cosine_hemisphere(next_2d(rng))
-                    }
-                    Lobe::Glossy => {
-                        only_specular_so_far = false;
-                        // Sampled in world space around the mirror direction.
-                        let Some((dir, w)) = p.sample_glossy(n, -ray.dir, next_2d(rng)) else {
-                            break;
-                        };
-                        power *= w / prob;
-                        frame.to_local(dir)
-                    }
-                }
-            }
-            Material::Mirror { reflectance } => {
-                power *= reflectance;
-                specular_bounces += 1;
-                reflect(wi)
-            }
-            Material::Glass { ior, .. } => {
-                specular_bounces += 1;
-                let entering = ray.dir.dot(hit.normal) < 0.0;
-                let (n_i, n_t) = if entering { (1.0, ior) } else { (ior, 1.0) };
-                let r = fresnel_dielectric(wi.z, n_i, n_t);
-                // Fresnel chooses the branch; the photon keeps its power.
-                match refract(wi, n_i / n_t) {
-                    Some(wt) if rng.random::<f32>() >= r => wt,
-                    _ => reflect(wi),
-                }
-            }
-            Material::Emitter => break,
-        };
-        if max_component(power) <= 0.0 {
-            break;
         }
-        let dir = frame.to_world(wo).normalize();
-        let (next, dep) = hit.spawn(dir);
-        (ray, departure) = (next, Some(dep));
+        if !alive {
+            return (rays, first);
+        }
     }
-    result
+}
+
+/// Casts one segment of `path`: stores a photon where it lands on a diffuse
+/// surface and samples the next direction. Returns whether the path goes
+/// on, and whether this was the first segment and it hit a specular surface.
+#[inline(always)]
+fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (bool, bool) {
+    let Path { ray, departure, power, rng, bounce, specular_bounces, only_specular_so_far } = path;
+    let rng = &mut *rng;
+    let bounce_now = *bounce;
+    *bounce += 1;
+    let Some(hit) = scene.intersect(ray, *departure) else {
+        return (false, false);
+    };
+    *power *= scene.transmittance(*departure, hit.t);
+    let n = hit.facing_normal(ray.dir);
+    let material = *scene.material(hit.prim);
+    let first_specular = bounce_now == 0 && material.is_specular();
+    let frame = Frame::from_normal(n);
+    let wi = frame.to_local(-ray.dir);
+    let stop = (false, first_specular);
+    let wo = match material {
+        Material::Lambertian { rho } => {
+            match pass {
+                // Light reaching a diffuse surface straight from the light is
+                // not a caustic (shadow rays count it); after a diffuse
+                // bounce it is indirect light (final gathering counts it).
+                Pass::Caustic => {
+                    if *only_specular_so_far && *specular_bounces > 0 && max_component(rho) > 0.0 {
+                        out.push(Photon::new(hit.point, *power, n));
+                    }
+                    return stop;
+                }
+                Pass::Global => {
+                    if max_component(rho) > 0.0 {
+                        out.push(Photon::new(hit.point, *power, n));
+                    }
+                }
+            }
+            // Russian roulette with the albedo: survivors carry power * rho / p.
+            let p = max_component(rho);
+            if !(rng.random::<f32>() < p) {
+                return stop;
+            }
+            *power *= rho / p;
+            *only_specular_so_far = false;
+            cosine_hemisphere(next_2d(rng))
+        }
+        Material::Phong(p) => {
+            // The Lambertian lobe stores photons as a Lambertian surface
+            // does; roulette then picks the lobe that carries the photon on.
+            let rho = p.diffuse_rho();
+            let store = max_component(rho) > 0.0;
+            match pass {
+                Pass::Caustic if store && *only_specular_so_far && *specular_bounces > 0 => {
+                    out.push(Photon::new(hit.point, *power, n));
+                }
+                Pass::Global if store => out.push(Photon::new(hit.point, *power, n)),
+                _ => {}
+            }
+            let Some((lobe, prob)) = p.choose_lobe(rng.random::<f32>()) else {
+                return stop;
+            };
+            match lobe {
+                Lobe::Mirror => {
+                    *power *= p.mirror_rho() / prob;
+                    *specular_bounces += 1;
+                    reflect(wi)
+                }
+                // A caustic path ends at its first non-specular bounce.
+                _ if pass == Pass::Caustic => return stop,
+                Lobe::Diffuse => {
+                    *power *= rho / prob;
+                    *only_specular_so_far = false;
+                    cosine_hemisphere(next_2d(rng))
+                }
+                Lobe::Glossy => {
+                    *only_specular_so_far = false;
+                    // Sampled in world space around the mirror direction.
+                    let Some((dir, w)) = p.sample_glossy(n, -ray.dir, next_2d(rng)) else {
+                        return stop;
+                    };
+                    *power *= w / prob;
+                    frame.to_local(dir)
+                }
+            }
+        }
+        Material::Mirror { reflectance } => {
+            *power *= reflectance;
+            *specular_bounces += 1;
+            reflect(wi)
+        }
+        Material::Glass { ior, .. } => {
+            *specular_bounces += 1;
+            let entering = ray.dir.dot(hit.normal) < 0.0;
+            let (n_i, n_t) = if entering { (1.0, ior) } else { (ior, 1.0) };
+            let r = fresnel_dielectric(wi.z, n_i, n_t);
+            // Fresnel chooses the branch; the photon keeps its power.
+            match refract(wi, n_i / n_t) {
+                Some(wt) if rng.random::<f32>() >= r => wt,
+                _ => reflect(wi),
+            }
+        }
+        Material::Emitter => return stop,
+    };
+    if max_component(*power) <= 0.0 || *bounce >= MAX_BOUNCES {
+        return stop;
+    }
+    let dir = frame.to_world(wo).normalize();
+    let (next, dep) = hit.spawn(dir);
+    (*ray, *departure) = (next, Some(dep));
+    (true, first_specular)
 }
 
 #[cfg(test)]
