@@ -7,6 +7,9 @@
 #   notes/tools/scaling.sh [BIN] [REPS] [THREADS...]
 #   notes/tools/scaling.sh target/release/photonmap 3 1 2 4 8 12 16
 #
+# The project builds for the CPU that builds (.cargo/config.toml); for
+# another machine build with RUSTFLAGS="-C target-cpu=x86-64-v3".
+#
 # Prints the raw runs as CSV (to $SCALING_CSV if set) and a markdown table.
 set -euo pipefail
 
