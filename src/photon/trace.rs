@@ -218,7 +218,15 @@ fn trace_range(
             let mut rng = stream(seed, domain, *next);
             *next += 1;
             if let Some((ray, departure, power)) = emit(scene, pass, n, &mut rng) {
-                return Some(Path { ray, departure, power, rng, bounce: 0, specular_bounces: 0, only_specular_so_far: true });
+                return Some(Path {
+                    ray,
+                    departure,
+                    power,
+                    rng,
+                    bounce: 0,
+                    specular_bounces: 0,
+                    only_specular_so_far: true,
+                });
             }
         }
         None
