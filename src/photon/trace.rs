@@ -258,7 +258,6 @@ fn trace_range(
 #[inline(always)]
 fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (bool, bool) {
     let Path { ray, departure, power, rng, bounce, specular_bounces, only_specular_so_far } = path;
-    let rng = &mut *rng;
     let bounce_now = *bounce;
     *bounce += 1;
     let Some(hit) = scene.intersect(ray, *departure) else {
