@@ -263,11 +263,12 @@ impl CellGrid {
         ((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]) as usize
     }
 
-    /// The ranges of photons in the rows of cells that meet the box of
-    /// half-width `r` around `x`, and their total length; `None` when there
-    /// are more than [`GRID_MAX_ROWS`] rows. The box is padded by a relative
-    /// 1e-5 so that rounding cannot leave out a photon at distance `r`.
-    fn rows(&self, x: Vec3, r: f32, rows: &mut [(u32, u32); GRID_MAX_ROWS]) -> Option<(usize, u32)> {
+    /// The cells (first and last on each axis) that meet the box of
+    /// half-width `r` around `x`, clamped to the grid (first > last where
+    /// the box misses it); `None` where the box is not finite. The box is
+    /// padded by a relative 1e-5 so that rounding cannot leave out a photon
+    /// at distance `r`.
+    fn cell_box(&self, x: Vec3, r: f32) -> Option<([i32; 3], [i32; 3])> {
         let pad = r * 1e-5 + (x - self.lo).abs().max_element() * 1e-6;
         let lo = (x - (r + pad) - self.lo) * self.inv_cell;
         let hi = (x + (r + pad) - self.lo) * self.inv_cell;
@@ -279,30 +280,50 @@ impl CellGrid {
             a[ax] = floor_i32(lo[ax]).max(0);
             b[ax] = floor_i32(hi[ax]).min(self.dims[ax] - 1);
             if a[ax] > b[ax] {
-                return Some((0, 0));
+                return Some(([0; 3], [-1; 3]));
             }
         }
-        if ((b[1] - a[1] + 1) * (b[2] - a[2] + 1)) as usize > GRID_MAX_ROWS {
-            return None;
-        }
-        let (mut n, mut total) = (0, 0);
+        Some((a, b))
+    }
+
+    /// The photons of each non-empty row of cells in `cell_box`, in index
+    /// order.
+    fn each_row(&self, (a, b): ([i32; 3], [i32; 3]), mut f: impl FnMut(u32, u32)) {
         for z in a[2]..=b[2] {
             for y in a[1]..=b[1] {
                 let row = self.index([0, y, z]);
                 let (s, e) = (self.start[row + a[0] as usize], self.start[row + b[0] as usize + 1]);
                 if e > s {
-                    rows[n] = (s, e);
-                    n += 1;
-                    total += e - s;
+                    f(s, e);
                 }
             }
         }
+    }
+
+    /// The ranges of photons in the rows of cells that meet the box of
+    /// half-width `r` around `x`, and their total length; `None` when there
+    /// are more than [`GRID_MAX_ROWS`] rows or the box is not finite.
+    fn rows(&self, x: Vec3, r: f32, rows: &mut [(u32, u32); GRID_MAX_ROWS]) -> Option<(usize, u32)> {
+        let (a, b) = self.cell_box(x, r)?;
+        if ((b[1] - a[1] + 1) * (b[2] - a[2] + 1)) as usize > GRID_MAX_ROWS {
+            return None;
+        }
+        let (mut n, mut total) = (0, 0);
+        self.each_row((a, b), |s, e| {
+            rows[n] = (s, e);
+            n += 1;
+            total += e - s;
+        });
         Some((n, total))
     }
 }
 
 /// A photon map: the photons, a kd-tree over their positions, and, when
-/// built with one, a grid of the photons' cells (`CellGrid`).
+/// built with one, a grid of the photons' cells (`CellGrid`). A map
+/// searched only at its own photons (the global map, read by the
+/// irradiance cache's estimates) has the grid alone when it has one: the
+/// grid then answers every search, and the tree, which cost half the map's
+/// build for a few hundred searches in 300,000, is not built.
 ///
 /// A search within radius r finds exactly the photons whose distance from
 /// the query, computed from their stored positions, is at most r: the grid
@@ -312,7 +333,8 @@ impl CellGrid {
 /// same whichever of the two answered it, with the grid or without.
 pub struct PhotonMap {
     photons: Vec<Photon>,
-    tree: PointTree,
+    /// `None`: the grid answers every search.
+    tree: Option<PointTree>,
     /// Where the tree's items (places in Morton order) are in `photons`,
     /// when the grid sorted them by cell.
     tree_place: Option<Vec<u32>>,
@@ -344,7 +366,7 @@ impl PhotonMap {
 
     /// A map searched only at its own photons (the irradiance cache's
     /// estimates), with a grid of cells `cell` wide where the photons are
-    /// sparse enough for it to pay, else the tree alone.
+    /// sparse enough for it to pay (and no tree), else the tree alone.
     pub fn build_for_photon_lookups(photons: impl Into<PhotonBlocks>, cell: f32) -> Self {
         Self::build_gridded(photons.into(), Some(cell), true)
     }
@@ -355,10 +377,14 @@ impl PhotonMap {
         // The tree is built from the Morton order (kiddo builds twice as
         // fast from spatially sorted points) while the grid sorts by cell.
         let (lo, hi) = bounds(morton.iter().map(Photon::position));
-        let (tree, gridded) = rayon::join(
-            || PointTree::build(morton.par_iter().map(|p| p.position())),
-            || cell.and_then(|c| CellGrid::build(&morton, (lo, hi), c, at_photons)),
-        );
+        let tree = || Some(PointTree::build(morton.par_iter().map(|p| p.position())));
+        let grid = || cell.and_then(|c| CellGrid::build(&morton, (lo, hi), c, at_photons));
+        let (tree, gridded) = if at_photons {
+            let gridded = grid();
+            (if gridded.is_some() { None } else { tree() }, gridded)
+        } else {
+            rayon::join(tree, grid)
+        };
         let reach = if morton.is_empty() { 0.0 } else { lo.abs().max(hi.abs()).max_element() };
         let tree_pad = reach * 1e-5;
         match gridded {
@@ -384,6 +410,9 @@ impl PhotonMap {
     /// every estimate is the same, bit for bit (the grid is a skip of work,
     /// and this is the skip forced off).
     pub fn without_grid(mut self) -> Self {
+        if self.tree.is_none() {
+            self.tree = Some(PointTree::build(self.morton_order().map(|p| p.position())));
+        }
         self.grid = None;
         self
     }
@@ -410,7 +439,7 @@ impl PhotonMap {
     /// Bytes held by the photons, the tree (an estimate: kiddo stores one
     /// f32 triple and one u32 per point, plus its stems) and the grid.
     pub fn memory_bytes(&self) -> usize {
-        self.photons.len() * (std::mem::size_of::<Photon>() + 16)
+        self.photons.len() * (std::mem::size_of::<Photon>() + self.tree.as_ref().map_or(0, |_| 16))
             + self.grid.as_ref().map_or(0, |g| g.start.len() * 4)
             + self.tree_place.as_ref().map_or(0, |p| p.len() * 4)
     }
@@ -425,30 +454,35 @@ impl PhotonMap {
         let mut rows = [(0, 0); GRID_MAX_ROWS];
         let r = r2.sqrt();
         if let Some(grid) = &self.grid {
-            if let Some((n, total)) = grid.rows(x, r, &mut rows) {
-                if total <= GRID_MAX_SCAN {
-                    if buf.len() < total as usize {
-                        buf.resize(total as usize, 0);
-                    }
-                    // Every candidate is written and the count advanced
-                    // only for those inside: many are not, and a branch on
-                    // it would be mispredicted often.
-                    let mut len = 0;
-                    for &(s, e) in &rows[..n] {
-                        for (i, p) in (s..e).zip(&self.photons[s as usize..e as usize]) {
-                            let d2 = p.position().distance_squared(x);
-                            buf[len] = found(d2, i);
-                            len += (d2 <= r2) as usize;
+            let listed = grid.rows(x, r, &mut rows);
+            let grid_only = self.tree.is_none();
+            if grid_only || listed.is_some_and(|(_, total)| total <= GRID_MAX_SCAN) {
+                let mut len = 0;
+                match listed {
+                    Some((n, _)) => {
+                        for &(s, e) in &rows[..n] {
+                            len = self.scan(x, r2, s, e, buf, len);
                         }
                     }
-                    let none_near = len == 0 && (r >= r_max || grid.rows(x, r_max, &mut rows) == Some((0, 0)));
-                    return (len, true, none_near);
+                    // Too many rows to list (a grid-only map's search at a
+                    // radius far above its cells): read them as they come.
+                    None => {
+                        if let Some(cells) = grid.cell_box(x, r) {
+                            grid.each_row(cells, |s, e| len = self.scan(x, r2, s, e, buf, len));
+                        }
+                    }
                 }
+                let none_near =
+                    len == 0 && (r >= r_max || !x.is_finite() || grid.rows(x, r_max, &mut rows) == Some((0, 0)));
+                return (len, true, none_near);
             }
         }
+        let Some(tree) = &self.tree else {
+            return (0, false, true);
+        };
         let wide = r + self.tree_pad + r * 1e-4;
         let mut len = 0;
-        self.tree.visit(x, wide * wide, |item| {
+        tree.visit(x, wide * wide, |item| {
             let i = self.tree_item(item);
             let d2 = self.photons[i as usize].position().distance_squared(x);
             if d2 <= r2 {
@@ -461,6 +495,25 @@ impl PhotonMap {
             }
         });
         (len, false, false)
+    }
+
+    /// Writes a [`found`] key for each photon of `s..e` within sqrt(`r2`)
+    /// of `x` to `buf[len..]`, growing `buf` if needed, and returns the new
+    /// length. Every candidate is written and the count advanced only for
+    /// those inside: many are not, and a branch on it would be mispredicted
+    /// often.
+    #[inline]
+    fn scan(&self, x: Vec3, r2: f32, s: u32, e: u32, buf: &mut Vec<u64>, mut len: usize) -> usize {
+        let need = len + (e - s) as usize;
+        if buf.len() < need {
+            buf.resize(need, 0);
+        }
+        for (i, p) in (s..e).zip(&self.photons[s as usize..e as usize]) {
+            let d2 = p.position().distance_squared(x);
+            buf[len] = found(d2, i);
+            len += (d2 <= r2) as usize;
+        }
+        len
     }
 
     /// Finds the `k` nearest photons within `r_max` of `x` (fewer if fewer are
@@ -1087,17 +1140,33 @@ mod tests {
     }
 
     /// A map searched at its photons keeps its grid only where a photon's
-    /// cell and its neighbours hold few enough to scan.
+    /// cell and its neighbours hold few enough to scan, and then has no
+    /// tree: the grid answers every search, also those with more rows or
+    /// photons than a map with a tree would read from it.
     #[test]
     fn photon_lookup_maps_keep_a_grid_only_where_it_pays() {
         let photons = uniform_floor(19, 50_000);
         // ~8 photons per 5 cm cell: kept. ~3,000 per 1 m cell: dropped.
         let fine = PhotonMap::build_for_photon_lookups(photons.clone(), 0.05);
-        let coarse = PhotonMap::build_for_photon_lookups(photons, 1.0);
-        assert!(fine.grid.is_some() && coarse.grid.is_none());
-        let path: Vec<Vec3> = (0..30).map(|i| Vec3::new(0.1 * i as f32 + 0.5, 0.0, 2.0)).collect();
-        for map in [&fine, &coarse] {
-            same_as_brute_force(map, map, &path, 30, 0.5);
+        let coarse = PhotonMap::build_for_photon_lookups(photons.clone(), 1.0);
+        assert!(fine.grid.is_some() && fine.tree.is_none());
+        assert!(coarse.grid.is_none() && coarse.tree.is_some());
+        // The tree is built when the grid is forced off.
+        let fine_tree = PhotonMap::build_for_photon_lookups(photons, 0.05).without_grid();
+        assert!(fine_tree.tree.is_some());
+        // The path leaves the floor's photons; at the 2.0 cap a search
+        // spans 81 x 81 rows and ~40,000 photons.
+        let path: Vec<Vec3> = (0..30).map(|i| Vec3::new(0.2 * i as f32 + 0.5, 0.0, 2.0)).collect();
+        let mut rows = [(0, 0); GRID_MAX_ROWS];
+        assert!(fine.grid.as_ref().unwrap().rows(path[5], 2.0, &mut rows).is_none());
+        for (k, r_max) in [(30, 0.5), (3000, 0.5), (30, 2.0), (20_000, 2.0)] {
+            same_as_brute_force(&fine, &fine_tree, &path, k, r_max);
+            same_as_brute_force(&coarse, &coarse, &path, k, r_max);
+        }
+        // Far from every photon, and at a point that is not one: nothing.
+        let mut s = Scratch::default();
+        for x in [Vec3::splat(50.0), Vec3::splat(f32::NAN)] {
+            assert_eq!(fine.irradiance(x, Vec3::Y, 30, 0.5, &mut s).0, Color::ZERO);
         }
     }
 
