@@ -316,6 +316,19 @@ impl CellGrid {
         });
         Some((n, total))
     }
+
+    /// The squared radius that would hold ~`k` of the `total` photons in
+    /// the rows around `x` at radius `r` if they were spread evenly over a
+    /// plane through the rows' box (a guess for the search's speed only:
+    /// the answer does not depend on it); `None` where there is none.
+    fn crowded_radius2(&self, x: Vec3, r: f32, total: u32, k: usize) -> Option<f32> {
+        let (a, b) = self.cell_box(x, r)?;
+        let mut sides = [0, 1, 2].map(|ax| (b[ax] - a[ax] + 1).max(0) as f32 / self.inv_cell);
+        sides.sort_by(f32::total_cmp);
+        let area = sides[1] * sides[2];
+        let r2 = 1.5 * k as f32 * area / (PI * total as f32);
+        (r2 > 0.0 && r2.is_finite()).then_some(r2)
+    }
 }
 
 /// A photon map: the photons, a kd-tree over their positions, and, when
@@ -450,12 +463,33 @@ impl PhotonMap {
     /// order (the grid finds them so; the tree in no set order), and
     /// whether the map holds none within `r_max` either (known only from
     /// the grid: the search can stop growing).
-    fn within(&self, x: Vec3, r2: f32, r_max: f32, buf: &mut Vec<u64>) -> (usize, bool, bool) {
+    ///
+    /// With `crowd_k > 0`, where the grid's rows hold too many photons to
+    /// scan and, at their mean density, a radius well below `r2` would
+    /// hold ~`crowd_k`, returns that squared radius instead (`Err`),
+    /// having searched nothing: a search that comes from a sparse region
+    /// with a wide radius into the caustic's focus would otherwise read
+    /// thousands of photons from the tree for one estimate.
+    fn within(
+        &self,
+        x: Vec3,
+        r2: f32,
+        r_max: f32,
+        buf: &mut Vec<u64>,
+        crowd_k: usize,
+    ) -> Result<(usize, bool, bool), f32> {
         let mut rows = [(0, 0); GRID_MAX_ROWS];
         let r = r2.sqrt();
         if let Some(grid) = &self.grid {
             let listed = grid.rows(x, r, &mut rows);
             let grid_only = self.tree.is_none();
+            if let (Some((_, total)), false) = (listed, grid_only) {
+                if total > GRID_MAX_SCAN && crowd_k > 0 {
+                    if let Some(smaller) = grid.crowded_radius2(x, r, total, crowd_k).filter(|&s| s < 0.5 * r2) {
+                        return Err(smaller.max(r2 / 64.0));
+                    }
+                }
+            }
             if grid_only || listed.is_some_and(|(_, total)| total <= GRID_MAX_SCAN) {
                 let mut len = 0;
                 match listed {
@@ -474,11 +508,11 @@ impl PhotonMap {
                 }
                 let none_near =
                     len == 0 && (r >= r_max || !x.is_finite() || grid.rows(x, r_max, &mut rows) == Some((0, 0)));
-                return (len, true, none_near);
+                return Ok((len, true, none_near));
             }
         }
         let Some(tree) = &self.tree else {
-            return (0, false, true);
+            return Ok((0, false, true));
         };
         let wide = r + self.tree_pad + r * 1e-4;
         let mut len = 0;
@@ -494,7 +528,7 @@ impl PhotonMap {
                 len += 1;
             }
         });
-        (len, false, false)
+        Ok((len, false, false))
     }
 
     /// Writes a [`found`] key for each photon of `s..e` within sqrt(`r2`)
@@ -534,9 +568,18 @@ impl PhotonMap {
         // photons near the answer only.
         let mut r2 = if k > 0 && scratch.hint_r2 > 0.0 { scratch.hint_r2.min(r_max2) } else { r_max2 };
         let (mut count, mut ordered);
+        // The radius is narrowed at most once (see `within`); from there
+        // it only grows, so the loop ends.
+        let mut may_narrow = k > 0;
         let r2 = loop {
             let none_near;
-            (count, ordered, none_near) = self.within(x, r2, r_max, buf);
+            match self.within(x, r2, r_max, buf, if may_narrow { k } else { 0 }) {
+                Ok(found) => (count, ordered, none_near) = found,
+                Err(narrower) => {
+                    (r2, may_narrow) = (narrower, false);
+                    continue;
+                }
+            }
             if k > 0 && count >= k {
                 // Keys rank photons at equal distances (f32 squares do tie,
                 // a few times per million estimates) by index: the k-th key
@@ -1092,7 +1135,8 @@ mod tests {
     }
 
     /// The grid's rows, the tree, and the two mixed (the tree answers where
-    /// rows hold too many photons) find exactly the k nearest that a brute
+    /// rows hold too many photons, at a radius first narrowed to their
+    /// density when the search comes in wide) find exactly the k nearest that a brute
     /// force over every photon finds, in any query order, and the estimates
     /// sum them in the same order: the same bits.
     #[test]
