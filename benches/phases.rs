@@ -5,7 +5,7 @@ use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughpu
 use photonmap::photon::map::{IrradianceCache, PhotonMap, Scratch};
 use photonmap::photon::trace::{trace_pass, Pass};
 use photonmap::progress::Mode;
-use photonmap::render::{render, Settings};
+use photonmap::render::{cache_stride, render, Settings, GLOBAL_GRID_CELL, GLOBAL_RADIUS_FRACTION};
 use photonmap::scene::{Eye, Scene};
 use std::hint::black_box;
 
@@ -31,6 +31,20 @@ fn kd_tree_build(c: &mut Criterion) {
     // and a name carrying it would leave the committed baseline behind.
     g.bench_function("200k_emitted", |b| {
         b.iter_batched(|| photons.clone(), |p| black_box(PhotonMap::build(p).len()), BatchSize::LargeInput)
+    });
+    // The global map as a render builds it (a grid sized for the cache's
+    // searches, no tree where the grid serves them all), and the
+    // irradiance cache computed from it.
+    let r_global = GLOBAL_RADIUS_FRACTION * scene.diagonal();
+    g.bench_function("global_map_and_cache_200k_emitted", |b| {
+        b.iter_batched(
+            || photons.clone(),
+            |p| {
+                let map = PhotonMap::build_for_photon_lookups(p, r_global * GLOBAL_GRID_CELL);
+                black_box(IrradianceCache::build(&map, cache_stride(100), 100, r_global).len())
+            },
+            BatchSize::LargeInput,
+        )
     });
     g.finish();
 }

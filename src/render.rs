@@ -330,7 +330,7 @@ fn photon_pass(
 /// percent of the cap where photons are dense), not for the cap. The
 /// grid's cell budget widens them in a large scene, and where photons are
 /// so dense that searches would read too many the map goes without.
-const GLOBAL_GRID_CELL: f32 = 0.025;
+pub const GLOBAL_GRID_CELL: f32 = 0.025;
 
 /// The seed of pass `pass`: pass 0 uses the seed itself, so a one-pass
 /// progressive render is the classic render's photon set.
