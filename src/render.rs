@@ -103,7 +103,8 @@ impl Settings {
     /// Bytes the render will hold at its peak, estimated from the measured
     /// default scene: ~5 stored global photons per emitted one (Russian
     /// roulette with albedo 0.8), each 28 bytes plus ~16 in the kd-tree and
-    /// as much again while the tree is built; one caustic photon per emitted
+    /// as much again while the tree is built (a bound: a global map that
+    /// keeps its grid builds no tree); one caustic photon per emitted
     /// one; the film in f32 and its rows in flight.
     pub fn estimated_peak_bytes(&self) -> u64 {
         let per_photon = std::mem::size_of::<crate::photon::Photon>() as u64 + 16 + 24;
