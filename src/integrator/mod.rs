@@ -11,7 +11,7 @@ pub mod whitted;
 
 use crate::math::{Color, Frame, Ray};
 use crate::optics::{fresnel_dielectric, reflect, refract};
-use crate::photon::map::Scratch;
+use crate::photon::map::{CellRange, Scratch};
 use crate::sampling::{next_2d, stratified_2d, Rng};
 use crate::scene::{Hit, Scene};
 use glam::Vec3;
@@ -32,8 +32,30 @@ pub enum Part {
 
 /// A camera-ray estimator.
 pub trait Integrator: Sync {
-    /// Radiance arriving along a camera ray (towards its origin).
+    /// Radiance arriving along a camera ray (towards its origin), less what
+    /// it left in `ctx.pending` (none where that is `None`).
     fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context) -> Color;
+
+    /// The radiance of reads left in `pending` by [`Self::radiance`], which
+    /// it empties.
+    fn resolve(&self, pending: &mut Vec<PendingRead>, ctx: &mut Context) -> Color {
+        let _ = ctx;
+        pending.clear();
+        Color::ZERO
+    }
+}
+
+/// A read of precomputed irradiance that a camera sample leaves for later:
+/// the camera pass resolves a pixel's reads together, so that their cache
+/// misses overlap instead of following one another (final gathering's
+/// reads land anywhere in the scene).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PendingRead {
+    pub point: Vec3,
+    pub normal: Vec3,
+    /// What the irradiance there is multiplied by on its way to the camera.
+    pub weight: Color,
+    pub cell: CellRange,
 }
 
 /// Per-thread state: random stream, scratch for lookups, counters, and
@@ -44,6 +66,9 @@ pub struct Context<'r> {
     pub tally: &'r mut Tally,
     pub pixel: u64,
     pub memo: &'r mut PixelMemo,
+    /// Where reads may be left for [`Integrator::resolve`]; `None`: made
+    /// at once.
+    pub pending: Option<&'r mut Vec<PendingRead>>,
 }
 
 /// What one pixel's samples share, and only they: it starts empty at every

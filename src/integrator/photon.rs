@@ -16,10 +16,10 @@
 //! Gather rays that reach a light (directly or through mirrors and glass)
 //! add nothing: those paths belong to the first two rows.
 
-use super::{direct_light, glass_branches, CausticMemo, Context, Integrator, Part};
+use super::{direct_light, glass_branches, CausticMemo, Context, Integrator, Part, PendingRead};
 use crate::material::{Material, Phong};
 use crate::math::{max_component, Color, Frame, Ray};
-use crate::photon::map::{CellRange, IrradianceCache, PhotonMap};
+use crate::photon::map::{IrradianceCache, PhotonMap};
 use crate::sampling::{cosine_hemisphere, next_2d, stratified_2d};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;
@@ -38,9 +38,6 @@ const MAX_SPECULAR_DEPTH: u32 = 24;
 /// this (cosine) of its own: the same plane, or a curved surface's nearby
 /// point.
 const REUSE_NORMAL_COSINE: f32 = 0.999;
-
-/// Gather rays traced before their cache reads (see `indirect`).
-const GATHER_BATCH: usize = 8;
 
 /// A gather ray's diffuse hit: where the cache is read, and with what weight.
 #[derive(Clone, Copy, Default)]
@@ -76,46 +73,72 @@ pub struct PhotonIntegrator<'a> {
 
 impl Integrator for PhotonIntegrator<'_> {
     fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context) -> Color {
-        self.trace(ray, None, 0, part, ctx)
+        self.trace(ray, None, 0, part, Color::ONE, ctx)
+    }
+
+    /// Finds every read's cell first (each cell's slot was fetched when its
+    /// gather ray hit, and this starts fetching the points), then reads.
+    fn resolve(&self, pending: &mut Vec<PendingRead>, ctx: &mut Context) -> Color {
+        for p in pending.iter_mut() {
+            p.cell = self.cache.locate(p.point);
+        }
+        let mut sum = Color::ZERO;
+        for p in pending.iter() {
+            sum += p.weight * self.cache.lookup_in(p.point, p.normal, p.cell, ctx.scratch);
+        }
+        pending.clear();
+        ctx.checked(sum, "indirect")
     }
 }
 
+/// In the functions below, `w` is what radiance leaving the current vertex
+/// is multiplied by on its way to the camera: the weight of a read left
+/// for later (see [`PendingRead`]).
 impl PhotonIntegrator<'_> {
-    fn trace(&self, ray: Ray, departure: Option<Departure>, depth: u32, part: Part, ctx: &mut Context) -> Color {
+    fn trace(
+        &self,
+        ray: Ray,
+        departure: Option<Departure>,
+        depth: u32,
+        part: Part,
+        w: Color,
+        ctx: &mut Context,
+    ) -> Color {
         ctx.tally.rays += 1;
         let Some(hit) = self.scene.intersect(&ray, departure) else {
             return Color::ZERO;
         };
         let through = self.scene.transmittance(departure, hit.t);
+        let w = w * through;
         let radiance = match *self.scene.material(hit.prim) {
             Material::Emitter if part == Part::Reflected => Color::ZERO,
             Material::Emitter => self.scene.light_of(hit.prim).map_or(Color::ZERO, |l| l.radiance_towards(ray.dir)),
-            Material::Lambertian { rho } => self.surface(&hit, &ray, rho, None, depth, part, ctx),
-            Material::Phong(p) => self.surface(&hit, &ray, p.diffuse_rho(), Some(&p), depth, part, ctx),
-            Material::Mirror { reflectance } => self.mirror(&hit, &ray, reflectance, depth, part, ctx),
+            Material::Lambertian { rho } => self.surface(&hit, &ray, rho, None, depth, part, w, ctx),
+            Material::Phong(p) => self.surface(&hit, &ray, p.diffuse_rho(), Some(&p), depth, part, w, ctx),
+            Material::Mirror { reflectance } => self.mirror(&hit, &ray, reflectance, depth, part, w, ctx),
             Material::Glass { ior, .. } => {
                 if depth >= MAX_SPECULAR_DEPTH {
                     return Color::ZERO;
                 }
                 let branches = glass_branches(&hit, &ray, ior);
-                let reflected = |s: &Self, ctx: &mut Context| {
+                let reflected = |s: &Self, w: Color, ctx: &mut Context| {
                     let (next, dep) = hit.spawn(branches.reflected);
-                    s.trace(next, Some(dep), depth + 1, part, ctx)
+                    s.trace(next, Some(dep), depth + 1, part, w, ctx)
                 };
                 match branches.refracted {
-                    None => reflected(self, ctx),
+                    None => reflected(self, w, ctx),
                     Some((wt, radiance_scale)) => {
-                        let refracted = |s: &Self, ctx: &mut Context| {
+                        let refracted = |s: &Self, w: Color, ctx: &mut Context| {
                             let (next, dep) = hit.spawn(wt);
-                            radiance_scale * s.trace(next, Some(dep), depth + 1, part, ctx)
+                            radiance_scale * s.trace(next, Some(dep), depth + 1, part, w * radiance_scale, ctx)
                         };
                         let r = branches.fresnel;
                         if depth < SPLIT_DEPTH {
-                            r * reflected(self, ctx) + (1.0 - r) * refracted(self, ctx)
+                            r * reflected(self, w * r, ctx) + (1.0 - r) * refracted(self, w * (1.0 - r), ctx)
                         } else if ctx.rng.random::<f32>() < r {
-                            reflected(self, ctx)
+                            reflected(self, w, ctx)
                         } else {
-                            refracted(self, ctx)
+                            refracted(self, w, ctx)
                         }
                     }
                 }
@@ -125,12 +148,22 @@ impl PhotonIntegrator<'_> {
     }
 
     /// Radiance leaving a perfect mirror of `reflectance` along `-ray.dir`.
-    fn mirror(&self, hit: &Hit, ray: &Ray, reflectance: Color, depth: u32, part: Part, ctx: &mut Context) -> Color {
+    #[allow(clippy::too_many_arguments)]
+    fn mirror(
+        &self,
+        hit: &Hit,
+        ray: &Ray,
+        reflectance: Color,
+        depth: u32,
+        part: Part,
+        w: Color,
+        ctx: &mut Context,
+    ) -> Color {
         if depth >= MAX_SPECULAR_DEPTH || max_component(reflectance) <= 0.0 {
             return Color::ZERO;
         }
         let (next, dep) = hit.spawn(hit.mirrored(ray.dir));
-        reflectance * self.trace(next, Some(dep), depth + 1, part, ctx)
+        reflectance * self.trace(next, Some(dep), depth + 1, part, w * reflectance, ctx)
     }
 
     /// A surface with a Lambertian lobe `rho` and, for the Phong material,
@@ -144,10 +177,11 @@ impl PhotonIntegrator<'_> {
         phong: Option<&Phong>,
         depth: u32,
         part: Part,
+        w: Color,
         ctx: &mut Context,
     ) -> Color {
         let mirrored = match phong {
-            Some(p) => self.mirror(hit, ray, p.mirror_rho(), depth, part, ctx),
+            Some(p) => self.mirror(hit, ray, p.mirror_rho(), depth, part, w, ctx),
             None => Color::ZERO,
         };
         // A glowing surface's own light (zero for all but area lights).
@@ -166,13 +200,13 @@ impl PhotonIntegrator<'_> {
         let (mut caustic, mut indirect) = (Color::ZERO, Color::ZERO);
         if max_component(rho) > 0.0 {
             caustic = self.caustic(hit, n, rho, ctx);
-            indirect = self.indirect(hit, n, rho, ctx);
+            indirect = self.indirect(hit, n, rho, w, ctx);
         }
         if let Some(p) = phong.filter(|_| glossy) {
             // One gather ray from the glossy lobe: indirect light it reflects.
             if let Some((dir, weight)) = p.sample_glossy(n, to_viewer, next_2d(ctx.rng)) {
                 let (next, dep) = hit.spawn(dir);
-                indirect += weight * self.gather(next, dep, ctx);
+                indirect += weight * self.gather(next, dep, w * weight, ctx);
             }
         }
         mirrored
@@ -204,57 +238,63 @@ impl PhotonIntegrator<'_> {
 
     /// Light → … diffuse y → (specular*) → x: final gathering.
     ///
-    /// The rays are traced first and the cache read after, a batch at a
-    /// time: each read is a cache miss (gather hits land anywhere in the
-    /// scene), and announcing a batch's addresses before reading any lets
-    /// the memory system fetch them together instead of one after another.
-    /// The random numbers are drawn in the same order either way.
-    fn indirect(&self, hit: &Hit, n: glam::Vec3, rho: Color, ctx: &mut Context) -> Color {
+    /// Each read of the cache is a cache miss (gather hits land anywhere in
+    /// the scene): where the camera pass lets it, the reads are left in
+    /// `ctx.pending` and made at the end of the pixel's samples, all of
+    /// their fetches under way at once (~5% off the camera pass, stop 16);
+    /// else made here. The random numbers are drawn in the same order
+    /// either way.
+    fn indirect(&self, hit: &Hit, n: glam::Vec3, rho: Color, w: Color, ctx: &mut Context) -> Color {
         let count = self.settings.gather_rays;
         if count == 0 || self.cache.is_empty() {
             return Color::ZERO;
         }
         let frame = Frame::from_normal(n);
-        let mut sum = Color::ZERO;
-        let mut batch = [GatherHit::default(); GATHER_BATCH];
-        let mut g = 0;
-        while g < count {
-            let size = (count - g).min(GATHER_BATCH as u32) as usize;
-            for slot in batch.iter_mut().take(size) {
-                let dir = frame.to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(ctx.rng)))).normalize();
-                let (ray, dep) = hit.spawn(dir);
-                *slot = self.gather_hit(ray, dep, ctx);
-                self.cache.prefetch_cell(slot.point);
-                g += 1;
-            }
-            let mut cells = [CellRange::default(); GATHER_BATCH];
-            for (cell, h) in cells.iter_mut().zip(&batch[..size]) {
-                *cell = self.cache.locate(h.point);
-            }
-            for (&cell, h) in cells.iter().zip(&batch[..size]) {
-                sum += self.read_cache(h, cell, ctx);
-            }
-        }
         // Cosine-weighted directions: f cos / pdf = (rho / pi) cos / (cos / pi) = rho.
+        let w = w * rho / count as f32;
+        let mut sum = Color::ZERO;
+        for g in 0..count {
+            let dir = frame.to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(ctx.rng)))).normalize();
+            let (ray, dep) = hit.spawn(dir);
+            let h = self.gather_hit(ray, dep, ctx);
+            sum += self.read(&h, w, ctx);
+        }
         rho * sum / count as f32
     }
 
     /// Radiance arriving along a gather ray that was reflected by a diffuse
     /// surface at least once before: followed through mirrors and glass to
     /// the first diffuse y, where the global map's irradiance is read.
-    fn gather(&self, ray: Ray, dep: Departure, ctx: &mut Context) -> Color {
+    fn gather(&self, ray: Ray, dep: Departure, w: Color, ctx: &mut Context) -> Color {
         if self.cache.is_empty() {
             return Color::ZERO;
         }
         let h = self.gather_hit(ray, dep, ctx);
-        self.read_cache(&h, self.cache.locate(h.point), ctx)
+        self.read(&h, w, ctx)
     }
 
-    fn read_cache(&self, h: &GatherHit, cell: CellRange, ctx: &mut Context) -> Color {
+    /// The irradiance read at gather hit `h` times its weight; or, where
+    /// `ctx.pending` takes reads, zero, the read left there with weight `w`
+    /// times the hit's (`w`: what the radiance leaving along the gather ray
+    /// is multiplied by on its way to the camera) and its cell's slot
+    /// being fetched.
+    fn read(&self, h: &GatherHit, w: Color, ctx: &mut Context) -> Color {
         if h.weight == Color::ZERO {
             return Color::ZERO;
         }
-        h.weight * self.cache.lookup_in(h.point, h.normal, cell, ctx.scratch)
+        match ctx.pending.as_deref_mut() {
+            Some(pending) => {
+                self.cache.prefetch_cell(h.point);
+                pending.push(PendingRead {
+                    point: h.point,
+                    normal: h.normal,
+                    weight: w * h.weight,
+                    ..Default::default()
+                });
+                Color::ZERO
+            }
+            None => h.weight * self.cache.lookup(h.point, h.normal, ctx.scratch),
+        }
     }
 
     /// Where a gather ray, followed through mirrors and glass, meets its
