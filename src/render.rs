@@ -504,14 +504,7 @@ fn light_rims(camera: &Camera, integrator: &impl Integrator, seed: u64, pass: u6
                 *count = (0..PROBES)
                     .filter(|&s| {
                         let ray = camera.ray(col, row, stratified_2d(s, PROBES, next_2d(&mut rng)));
-                        let mut ctx = Context {
-                            rng: &mut rng,
-                            scratch,
-                            tally: &mut tally,
-                            pixel,
-                            memo: &mut memo,
-                            pending: None,
-                        };
+                        let mut ctx = Context::new(&mut rng, scratch, &mut tally, pixel, &mut memo, None);
                         max_component(integrator.radiance(ray, Part::Emitted, &mut ctx)) > 0.0
                     })
                     .count() as u8;
@@ -585,29 +578,14 @@ fn camera_pass(
                     // The samples' cache reads are left for the end of the
                     // estimate and made together (`PendingRead`).
                     let mut estimate = |part: Part, n: u32| {
+                        let mut ctx =
+                            Context::new(&mut rng, scratch, &mut tally, pixel, &mut memo, Some(&mut *pending));
                         let mut sum = DVec3::ZERO;
                         for s in 0..n {
-                            let u = stratified_2d(s, n, next_2d(&mut rng));
-                            let ray = camera.ray(col, row, u);
-                            let mut ctx = Context {
-                                rng: &mut rng,
-                                scratch,
-                                tally: &mut tally,
-                                pixel,
-                                memo: &mut memo,
-                                pending: Some(&mut *pending),
-                            };
+                            let ray = camera.ray(col, row, stratified_2d(s, n, next_2d(ctx.rng)));
                             sum += integrator.radiance(ray, part, &mut ctx).as_dvec3();
                         }
-                        let mut ctx = Context {
-                            rng: &mut rng,
-                            scratch,
-                            tally: &mut tally,
-                            pixel,
-                            memo: &mut memo,
-                            pending: None,
-                        };
-                        sum += integrator.resolve(pending, &mut ctx).as_dvec3();
+                        sum += integrator.resolve(&mut ctx).as_dvec3();
                         sum / n as f64
                     };
                     let value = if rim {
@@ -653,32 +631,21 @@ mod tests {
         let mut reads = 0;
         for pixel in 0..48 * 48u64 {
             let ray = camera.ray(pixel as u32 % 48, pixel as u32 / 48, glam::Vec2::splat(0.5));
+            // Returns the radiance, and the reads left and their radiance.
             let mut run = |pending: Option<&mut Vec<PendingRead>>| {
                 let (mut rng, mut memo) = (stream(3, Domain::Camera, pixel), PixelMemo::default());
-                let mut ctx = Context {
-                    rng: &mut rng,
-                    scratch: &mut scratch,
-                    tally: &mut tally,
-                    pixel,
-                    memo: &mut memo,
-                    pending,
-                };
-                integrator.radiance(ray, Part::All, &mut ctx)
+                let mut ctx = Context::new(&mut rng, &mut scratch, &mut tally, pixel, &mut memo, pending);
+                let radiance = integrator.radiance(ray, Part::All, &mut ctx);
+                let left = ctx.pending.as_ref().map_or(0, |p| p.len());
+                let resolved = integrator.resolve(&mut ctx);
+                assert!(ctx.pending.as_ref().is_none_or(|p| p.is_empty()));
+                (radiance, left, resolved)
             };
-            let at_once = run(None);
-            let left = run(Some(&mut pending));
-            reads += pending.len();
-            let (mut rng, mut memo) = (stream(3, Domain::Camera, pixel), PixelMemo::default());
-            let mut ctx = Context {
-                rng: &mut rng,
-                scratch: &mut scratch,
-                tally: &mut tally,
-                pixel,
-                memo: &mut memo,
-                pending: None,
-            };
-            let resolved = left + integrator.resolve(&mut pending, &mut ctx);
-            assert!(pending.is_empty());
+            let (at_once, none_left, _) = run(None);
+            assert_eq!(none_left, 0);
+            let (radiance, left, pending_radiance) = run(Some(&mut pending));
+            reads += left;
+            let resolved = radiance + pending_radiance;
             for c in 0..3 {
                 let (a, b) = (at_once[c], resolved[c]);
                 assert!((a - b).abs() <= 1e-5 * a.abs().max(1e-3), "pixel {pixel}: {at_once} at once, {resolved} left");

@@ -36,11 +36,12 @@ pub trait Integrator: Sync {
     /// it left in `ctx.pending` (none where that is `None`).
     fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context) -> Color;
 
-    /// The radiance of reads left in `pending` by [`Self::radiance`], which
-    /// it empties.
-    fn resolve(&self, pending: &mut Vec<PendingRead>, ctx: &mut Context) -> Color {
-        let _ = ctx;
-        pending.clear();
+    /// The radiance of the reads [`Self::radiance`] left in `ctx.pending`,
+    /// which it empties.
+    fn resolve(&self, ctx: &mut Context) -> Color {
+        if let Some(pending) = ctx.pending.as_deref_mut() {
+            pending.clear();
+        }
         Color::ZERO
     }
 }
@@ -89,7 +90,17 @@ pub struct CausticMemo {
     pub estimate: crate::photon::map::ConeEstimate,
 }
 
-impl Context<'_> {
+impl<'r> Context<'r> {
+    pub fn new(
+        rng: &'r mut Rng,
+        scratch: &'r mut Scratch,
+        tally: &'r mut Tally,
+        pixel: u64,
+        memo: &'r mut PixelMemo,
+        pending: Option<&'r mut Vec<PendingRead>>,
+    ) -> Self {
+        Context { rng, scratch, tally, pixel, memo, pending }
+    }
     /// Passes a finite estimate through; counts and drops a non-finite one,
     /// remembering the first (pixel, estimator). Debug builds stop there.
     pub fn checked(&mut self, c: Color, estimator: &'static str) -> Color {

@@ -78,7 +78,10 @@ impl Integrator for PhotonIntegrator<'_> {
 
     /// Finds every read's cell first (each cell's slot was fetched when its
     /// gather ray hit, and this starts fetching the points), then reads.
-    fn resolve(&self, pending: &mut Vec<PendingRead>, ctx: &mut Context) -> Color {
+    fn resolve(&self, ctx: &mut Context) -> Color {
+        let Some(pending) = ctx.pending.take() else {
+            return Color::ZERO;
+        };
         for p in pending.iter_mut() {
             p.cell = self.cache.locate(p.point);
         }
@@ -87,6 +90,7 @@ impl Integrator for PhotonIntegrator<'_> {
             sum += p.weight * self.cache.lookup_in(p.point, p.normal, p.cell, ctx.scratch);
         }
         pending.clear();
+        ctx.pending = Some(pending);
         ctx.checked(sum, "indirect")
     }
 }
