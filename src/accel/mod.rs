@@ -13,7 +13,7 @@ pub mod enclosure;
 use crate::math::Ray;
 use crate::shape::{Departure, Shape, ShapeHit};
 use enclosure::Enclosure;
-use glam::{Vec3, Vec3A};
+use glam::{Vec3, Vec3A, Vec4};
 
 const BINS: usize = 16;
 /// Up to this many primitives a flat loop beats the hierarchy. With the
@@ -33,9 +33,32 @@ struct Node {
     count: u32,
 }
 
+/// A node of the 4-wide hierarchy the traversal walks: four children's
+/// boxes in SIMD lanes, tested at once. It is the binary SAH tree with
+/// every other level folded in (nodes with the largest boxes opened
+/// first): random rays in the default room visit one node, not the
+/// binary tree's chain of two-box tests whose branches they mispredict.
+#[derive(Clone, Copy, Debug)]
+struct Node4 {
+    min: [Vec4; 3],
+    max: [Vec4; 3],
+    /// Interior child: its node. Leaf child: its first primitive in leaf order.
+    child: [u32; 4],
+    /// Primitives of a leaf child; 0 for an interior child.
+    count: [u32; 4],
+    /// Bit k set where lane k holds a child.
+    used: u32,
+}
+
+/// Entries the traversal stack holds. A node pushes at most three more
+/// than it pops, so 128 hold a path 42 nodes deep (a binary tree of ~84
+/// levels; the binary traversal's stack held 64); a full stack would drop
+/// far boxes rather than overrun.
+const STACK: usize = 128;
+
 pub struct Accel {
     /// Empty when the primitives are few enough to test them all.
-    nodes: Vec<Node>,
+    nodes: Vec<Node4>,
     /// Shapes in leaf order, with their index in the scene (those of the
     /// enclosure left out).
     shapes: Vec<(Shape, u32)>,
@@ -93,10 +116,12 @@ impl Accel {
                 Item { min, max, centroid: 0.5 * (min + max), index: i }
             })
             .collect();
-        let mut nodes = Vec::with_capacity(2 * items.len().max(1));
-        nodes.push(Node { min: Vec3::ZERO, max: Vec3::ZERO, first: 0, count: 0 });
+        let mut binary = Vec::with_capacity(2 * items.len().max(1));
+        binary.push(Node { min: Vec3::ZERO, max: Vec3::ZERO, first: 0, count: 0 });
+        let mut nodes = Vec::new();
         if !items.is_empty() {
-            build(&mut nodes, 0, &mut items, 0);
+            build(&mut binary, 0, &mut items, 0);
+            collapse(&binary, &mut nodes, 0);
         }
         let ordered = items.iter().map(|it| (shapes[it.index as usize], it.index)).collect();
         Accel { nodes, shapes: ordered, enclosure }
@@ -190,40 +215,60 @@ impl Accel {
             return;
         }
         let inv = Vec3A::from(ray.dir).recip();
-        let origin = Vec3A::from(ray.origin);
-        let mut stack = [0u32; 64];
+        let origin = [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)];
+        let inv = [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)];
+        // Interior children to open later, (node, entry distance), nearest
+        // on top; made on the first push (a tree of one node never needs it,
+        // and zeroing it per ray cost more than the default room's rays).
+        let mut stack: Option<[(u32, f32); STACK]> = None;
         let mut top = 0usize;
         let mut node = 0u32;
         loop {
             let n = &self.nodes[node as usize];
-            if n.count > 0 {
-                for (shape, index) in &self.shapes[n.first as usize..(n.first + n.count) as usize] {
-                    if visit(shape, *index, &mut t_limit) {
-                        return;
+            let (t_in, t_out) = entries(n, origin, inv);
+            let mut hits =
+                (t_in.cmple(t_out) & t_in.cmple(Vec4::splat(t_limit)) & t_in.cmplt(Vec4::INFINITY)).bitmask() & n.used;
+            let t_in = t_in.to_array();
+            // The boxes entered, nearest first (on a tie, the lower lane).
+            let mut order = [0usize; 4];
+            let mut entered = 0;
+            while hits != 0 {
+                let k = hits.trailing_zeros() as usize;
+                hits &= hits - 1;
+                let mut j = entered;
+                while j > 0 && t_in[order[j - 1]] > t_in[k] {
+                    order[j] = order[j - 1];
+                    j -= 1;
+                }
+                order[j] = k;
+                entered += 1;
+            }
+            // Leaves now, nearest first: their hits prune what follows.
+            for &k in &order[..entered] {
+                let count = n.count[k];
+                if count > 0 && t_in[k] <= t_limit {
+                    let first = n.child[k] as usize;
+                    for (shape, index) in &self.shapes[first..first + count as usize] {
+                        if visit(shape, *index, &mut t_limit) {
+                            return;
+                        }
                     }
                 }
-            } else {
-                let (a, b) = (n.first, n.first + 1);
-                let ta = entry(&self.nodes[a as usize], origin, inv);
-                let tb = entry(&self.nodes[b as usize], origin, inv);
-                let (near, t_near, far, t_far) = if ta <= tb { (a, ta, b, tb) } else { (b, tb, a, ta) };
-                if enters(t_near, t_limit) {
-                    if enters(t_far, t_limit) && top < stack.len() {
-                        stack[top] = far;
-                        top += 1;
-                    }
-                    node = near;
-                    continue;
+            }
+            // Interior children onto the stack, farthest first.
+            for &k in order[..entered].iter().rev() {
+                if n.count[k] == 0 && top < STACK {
+                    stack.get_or_insert([(0, 0.0); STACK])[top] = (n.child[k], t_in[k]);
+                    top += 1;
                 }
             }
             // Pop, skipping boxes that the shrinking closest hit now excludes.
             loop {
-                if top == 0 {
-                    return;
-                }
+                let Some(stack) = stack.as_ref().filter(|_| top > 0) else { return };
                 top -= 1;
-                node = stack[top];
-                if enters(entry(&self.nodes[node as usize], origin, inv), t_limit) {
+                let (child, t) = stack[top];
+                if t <= t_limit {
+                    node = child;
                     break;
                 }
             }
@@ -231,33 +276,67 @@ impl Accel {
     }
 }
 
-/// Whether a box entered at `t` (infinity: missed) can hold a hit before
-/// `t_limit`. A miss never qualifies, not even while no hit bounds the ray.
-#[inline]
-fn enters(t: f32, t_limit: f32) -> bool {
-    t <= t_limit && t != f32::INFINITY
+/// Distances at which the ray enters and leaves each of the node's four
+/// boxes (0 for a box it starts in); a box is missed where the entry
+/// comes after the exit. A lane is NaN only from 0 * inf (a ray parallel to
+/// a slab, starting on its plane): such a slab constrains nothing, so a box
+/// is never dropped for it (at worst a box the ray only grazes is visited).
+#[inline(always)]
+fn entries(n: &Node4, origin: [Vec4; 3], inv: [Vec4; 3]) -> (Vec4, Vec4) {
+    let mut t_in = Vec4::ZERO;
+    let mut t_out = Vec4::INFINITY;
+    for a in 0..3 {
+        let t0 = (n.min[a] - origin[a]) * inv[a];
+        let t1 = (n.max[a] - origin[a]) * inv[a];
+        let (near, far) = (t0.min(t1), t0.max(t1));
+        t_in = t_in.max(Vec4::select(near.is_nan_mask(), Vec4::NEG_INFINITY, near));
+        t_out = t_out.min(Vec4::select(far.is_nan_mask(), Vec4::INFINITY, far));
+    }
+    // Widen the exit by a few ulps so rounding never drops a box a ray grazes.
+    (t_in, t_out * (1.0 + 2.0 * crate::math::gamma(3)))
 }
 
-/// Distance at which the ray enters the box (0 if it starts inside), or
-/// infinity if it misses. The slabs are computed four lanes at a time; a
-/// lane is NaN only from 0 * inf (a ray parallel to a slab, starting on its
-/// plane), and the lanes are then reduced with `f32::max`/`min`, which
-/// ignore a NaN operand: such a slab constrains nothing, so a box is never
-/// dropped for it (at worst a box the ray only grazes is visited).
-#[inline(always)]
-fn entry(n: &Node, origin: Vec3A, inv: Vec3A) -> f32 {
-    let t0 = (Vec3A::from(n.min) - origin) * inv;
-    let t1 = (Vec3A::from(n.max) - origin) * inv;
-    let near = t0.min(t1);
-    let far = t0.max(t1);
-    let t_in = near.x.max(near.y).max(near.z).max(0.0);
-    // Widen the exit by a few ulps so rounding never drops a box a ray grazes.
-    let t_out = far.x.min(far.y).min(far.z) * (1.0 + 2.0 * crate::math::gamma(3));
-    if t_in <= t_out {
-        t_in
-    } else {
-        f32::INFINITY
+/// Folds the binary tree under `root` into 4-wide nodes appended to `out`;
+/// returns the index of the node made for `root`. Of the binary nodes below
+/// a 4-wide node, the interior one with the largest box is opened first,
+/// until there are four children or only leaves.
+fn collapse(binary: &[Node], out: &mut Vec<Node4>, root: usize) -> u32 {
+    let mut kids = vec![root];
+    while kids.len() < 4 {
+        let open = kids
+            .iter()
+            .enumerate()
+            .filter(|&(_, &k)| binary[k].count == 0)
+            .max_by(|a, b| {
+                area(binary[*a.1].min, binary[*a.1].max).total_cmp(&area(binary[*b.1].min, binary[*b.1].max))
+            })
+            .map(|(i, _)| i);
+        let Some(i) = open else { break };
+        let first = binary[kids[i]].first as usize;
+        kids.splice(i..=i, [first, first + 1]);
     }
+    let index = out.len();
+    out.push(Node4 { min: [Vec4::ZERO; 3], max: [Vec4::ZERO; 3], child: [0; 4], count: [0; 4], used: 0 });
+    let mut min = [[0.0f32; 4]; 3];
+    let mut max = [[0.0f32; 4]; 3];
+    let mut child = [0u32; 4];
+    let mut count = [0u32; 4];
+    for (lane, &k) in kids.iter().enumerate() {
+        let b = &binary[k];
+        for a in 0..3 {
+            min[a][lane] = b.min[a];
+            max[a][lane] = b.max[a];
+        }
+        (child[lane], count[lane]) = if b.count > 0 { (b.first, b.count) } else { (collapse(binary, out, k), 0) };
+    }
+    out[index] = Node4 {
+        min: min.map(Vec4::from_array),
+        max: max.map(Vec4::from_array),
+        child,
+        count,
+        used: (1u32 << kids.len()) - 1,
+    };
+    index as u32
 }
 
 fn build(nodes: &mut Vec<Node>, node: usize, items: &mut [Item], offset: u32) {
