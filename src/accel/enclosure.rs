@@ -178,13 +178,15 @@ impl Enclosure {
                     ny: lane(|f| f.n.y, 0.0),
                     nz: lane(|f| f.n.z, 0.0),
                     d: lane(|f| f.d, -1.0),
-                    face: Vec4::from_array(std::array::from_fn(|k| {
-                        if k < c.len() {
-                            (base + k) as f32
-                        } else {
-                            NO_FACE
-                        }
-                    })),
+                    face: Vec4::from_array(std::array::from_fn(
+                        |k| {
+                            if k < c.len() {
+                                (base + k) as f32
+                            } else {
+                                NO_FACE
+                            }
+                        },
+                    )),
                 }
             })
             .collect();
@@ -214,6 +216,43 @@ impl Enclosure {
         let (ox, oy, oz) = (Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z));
         let (dx, dy, dz) = (Vec4::splat(ray.dir.x), Vec4::splat(ray.dir.y), Vec4::splat(ray.dir.z));
         // u32::MAX becomes 2^32 in f32: no face's index.
+        let skip_lane = Vec4::splat(skip as f32);
+        // A ray from inside (inside every plane but the one it leaves) meets
+        // the nearest plane it crosses out of: no plane can be entered
+        // ahead of it, and none parallel to the ray can keep it out. Only
+        // that is computed here; anything else takes the general path.
+        let mut leaving = [Vec4::INFINITY; MAX_FACES / 4];
+        let mut nearest = Vec4::INFINITY;
+        let mut outside = glam::BVec4A::splat(false);
+        for (l, leave) in self.lanes.iter().zip(leaving.iter_mut()) {
+            let s = l.nx * ox + l.ny * oy + l.nz * oz - l.d;
+            let rate = l.nx * dx + l.ny * dy + l.nz * dz;
+            let keep = l.face.cmpne(skip_lane);
+            outside |= s.cmplt(Vec4::ZERO) & keep;
+            *leave = Vec4::select(rate.cmplt(Vec4::ZERO) & keep, -s / rate, Vec4::INFINITY);
+            nearest = nearest.min(*leave);
+        }
+        if outside.any() {
+            return self.hit_general(ray, skip, t_max);
+        }
+        let t = nearest.min_element();
+        // The lowest face reaching it (a ray through an edge meets two);
+        // lane k of chunk c is face 4c + k. Without a branch per chunk:
+        // random rays would mispredict which chunk holds it.
+        let reached = leaving[..self.lanes.len()]
+            .iter()
+            .enumerate()
+            .fold(0u32, |m, (c, leave)| m | leave.cmpeq(Vec4::splat(t)).bitmask() << (4 * c));
+        let face = reached.trailing_zeros();
+        (t > 0.0 && t < t_max && (face as usize) < self.faces.len()).then_some(EnclosureHit { t, face })
+    }
+
+    /// [`Enclosure::hit`] for any origin: inside, outside, or on a plane
+    /// other than the one it leaves.
+    #[cold]
+    fn hit_general(&self, ray: &Ray, skip: u32, t_max: f32) -> Option<EnclosureHit> {
+        let (ox, oy, oz) = (Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z));
+        let (dx, dy, dz) = (Vec4::splat(ray.dir.x), Vec4::splat(ray.dir.y), Vec4::splat(ray.dir.z));
         let skip = Vec4::splat(skip as f32);
         // Lane-wise nearest plane crossed out of and farthest crossed into,
         // and their faces; reduced across lanes once, after the loop. (A
@@ -380,6 +419,40 @@ mod tests {
         // (whose base lies on the floor) do not.
         assert!((0..24).all(|i| e.contains(i)));
         assert!((24..shapes.len() as u32).all(|i| !e.contains(i)));
+    }
+
+    /// The path for rays from inside must answer exactly as the general
+    /// one: rays from inside, from outside, and leaving a face from a
+    /// point on it (its own plane skipped, near edges and corners too).
+    #[test]
+    fn rays_from_inside_meet_the_face_the_general_path_finds() {
+        use crate::sampling::{next_2d, stream, uniform_cone, Domain};
+        let (shapes, group) = room_shapes();
+        let e = Enclosure::detect(&shapes, &group).unwrap();
+        let mut rng = stream(17, Domain::Camera, 0);
+        let (mut inside, mut on_face) = (0, 0);
+        for i in 0..300_000 {
+            let (a, b) = (next_2d(&mut rng), next_2d(&mut rng));
+            let dir = uniform_cone(next_2d(&mut rng), -1.0);
+            let (origin, skip) = if i % 2 == 0 {
+                // Anywhere in a box a little larger than the room.
+                (Vec3::new(-4.0 + 18.0 * a.x, -7.0 + 14.0 * a.y, -6.0 + 12.0 * b.x), NONE)
+            } else {
+                // On a wall triangle (corners and edges included), leaving it.
+                let prim = (b.y * 24.0) as usize % 24;
+                let Shape::Triangle(t) = shapes[prim] else { unreachable!() };
+                let (u, v) = if a.x + a.y > 1.0 { (1.0 - a.x, 1.0 - a.y) } else { (a.x, a.y) };
+                let (u, v) = if b.x < 0.1 { (u.round(), v.round() * (1.0 - u.round())) } else { (u, v) };
+                (t.v0 + u * (t.v1 - t.v0) + v * (t.v2 - t.v0), e.face_of(prim as u32))
+            };
+            let ray = Ray::new(origin, dir);
+            let fast = e.hit(&ray, skip, f32::INFINITY).map(|h| (h.t, h.face));
+            let general = e.hit_general(&ray, skip, f32::INFINITY).map(|h| (h.t, h.face));
+            assert_eq!(fast, general, "{ray:?} leaving face {skip}");
+            inside += fast.is_some() as u32;
+            on_face += (skip != NONE && fast.is_some()) as u32;
+        }
+        assert!(inside > 200_000 && on_face > 100_000, "{inside} {on_face}");
     }
 
     #[test]
