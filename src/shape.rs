@@ -265,8 +265,12 @@ impl Sphere {
         let local = ray.origin + t * ray.dir - self.center;
         let len = local.length();
         // A hit point at the centre needs a zero radius, which never hits.
-        let local = if len > 0.0 { local } else { Vec3::Z * self.radius };
-        let len = local.length();
+        let (local, len) = if len > 0.0 {
+            (local, len)
+        } else {
+            let z = Vec3::Z * self.radius;
+            (z, z.length())
+        };
         // Re-project onto the surface; the error is then a few ulps of the
         // local coordinates plus the rounding of adding the centre back.
         let local = local * (self.radius / len);

@@ -143,8 +143,11 @@ fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> Option<(Ray, Option
                 .iter()
                 .enumerate()
                 .map(|(j, t)| {
+                    if j == chosen_index {
+                        return uniform_cone_pdf(cos_max);
+                    }
                     let (a, c) = cone_towards(origin, t.center, t.radius);
-                    if j == chosen_index || dir.dot(a) >= c {
+                    if dir.dot(a) >= c {
                         uniform_cone_pdf(c)
                     } else {
                         0.0
