@@ -2,11 +2,12 @@
 //! of the renderer goes through here.
 //!
 //! A closed convex room of triangles is met as a polyhedron
-//! ([`enclosure`]); everything else sits in a binary bounding volume
-//! hierarchy built with the binned surface area heuristic (16 bins),
-//! traversed near child first with the current closest distance pruning the
-//! far one. The room is tested first: the wall a ray would reach bounds the
-//! search among the objects inside.
+//! ([`enclosure`]); everything else sits in a bounding volume hierarchy
+//! built binary with the binned surface area heuristic (16 bins), then
+//! folded into 4-wide nodes whose four boxes a ray tests at once, nearer
+//! boxes first, the current closest distance pruning the farther ones. The
+//! room is tested first: the wall a ray would reach bounds the search among
+//! the objects inside.
 
 pub mod enclosure;
 
