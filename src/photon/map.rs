@@ -7,7 +7,9 @@
 //! distances are unchanged by a rotation. Photons are stored in Morton order
 //! so that neighbours in space are neighbours in memory; the renderer's maps
 //! are then sorted by the cells of a uniform grid sized for their lookups,
-//! through which most lookups go instead of the tree.
+//! through which most lookups go instead of the tree. A map searched only
+//! at its own photons (the global map) has no tree where its grid pays, and
+//! then no Morton order either: its grid sorts the photons as traced.
 
 use super::{quantize_normal, Photon, PhotonBlocks};
 use crate::math::{floor_i32, Color};
@@ -216,8 +218,9 @@ impl CellGrid {
         }
         let d = (extent / cell).as_ivec3() + 1;
         let mut grid = CellGrid { lo, inv_cell: 1.0 / cell, dims: [d.x, d.y, d.z], start: Vec::new() };
-        // Sorted by (cell, position in Morton order): Morton order survives
-        // within cells, and the sort runs on every thread (a serial
+        // Sorted by (cell, position in the order given: Morton, or as
+        // traced): that order survives within cells, and the sort runs on
+        // every thread (a serial
         // counting sort of the global map's 4.9 M photons took 0.3 s).
         let n_cells = (d.x * d.y * d.z) as usize;
         let cell_index: Vec<u32> = photons.par_iter().map(|p| grid.index(grid.cell_of(p.position())) as u32).collect();
@@ -385,6 +388,27 @@ impl PhotonMap {
     }
 
     fn build_gridded(photons: PhotonBlocks, cell: Option<f32>, at_photons: bool) -> Self {
+        if let (Some(c), true) = (cell, at_photons) {
+            // A map searched only through its grid needs no Morton order
+            // (it served the tree, which this map does without): the grid
+            // sorts the photons by cell from the order they were traced in,
+            // and its cell order is the map's `spatial_order`. The
+            // Morton sort was 0.39 s of the default global map's build.
+            let (lo, hi) = bounds(photons.iter().map(Photon::position));
+            let traced: Vec<Photon> = photons.blocks().concat();
+            drop(photons);
+            if let Some((grid, sorted, _)) = CellGrid::build(&traced, (lo, hi), c, true) {
+                let reach = lo.abs().max(hi.abs()).max_element();
+                return PhotonMap {
+                    photons: sorted,
+                    tree: None,
+                    tree_place: None,
+                    grid: Some(grid),
+                    tree_pad: reach * 1e-5,
+                };
+            }
+            return Self::build_gridded(PhotonBlocks::new(vec![traced]), None, false);
+        }
         let morton = morton_sorted(&photons);
         drop(photons);
         // The tree is built from the Morton order (kiddo builds twice as
@@ -414,8 +438,10 @@ impl PhotonMap {
         self.tree_place.as_ref().map_or(item, |place| place[item as usize])
     }
 
-    /// The photons in Morton order.
-    fn morton_order(&self) -> impl IndexedParallelIterator<Item = &Photon> + '_ {
+    /// The photons in a spatially coherent order: Morton order, or, for a
+    /// map built without a tree (searched through its grid alone), the
+    /// grid's cell order. A tree forced on later is built in this order.
+    fn spatial_order(&self) -> impl IndexedParallelIterator<Item = &Photon> + '_ {
         (0..self.photons.len() as u32).into_par_iter().map(move |m| &self.photons[self.tree_item(m) as usize])
     }
 
@@ -424,7 +450,7 @@ impl PhotonMap {
     /// and this is the skip forced off).
     pub fn without_grid(mut self) -> Self {
         if self.tree.is_none() {
-            self.tree = Some(PointTree::build(self.morton_order().map(|p| p.position())));
+            self.tree = Some(PointTree::build(self.spatial_order().map(|p| p.position())));
         }
         self.grid = None;
         self
@@ -816,10 +842,10 @@ impl IrradianceCache {
             .photons
             .get(map.len() / 2)
             .map_or(0.0, |p| map.irradiance(p.position(), p.surface_normal(), k, r_max, &mut Scratch::default()).1);
-        // Every stride-th photon along the Morton order: spread evenly over
-        // the surfaces whatever order the map keeps its photons in.
+        // Every stride-th photon along the map's spatial order (Morton, or
+        // cell by cell): spread evenly over the surfaces.
         let computed: Vec<(CachePoint, f32)> = map
-            .morton_order()
+            .spatial_order()
             .step_by(stride)
             .map_init(
                 || Scratch::with_hint(hint),
@@ -862,7 +888,7 @@ impl IrradianceCache {
         if points.is_empty() || !extent.is_finite() || !index.inv_cell.is_finite() {
             return index;
         }
-        // Stable: equal cells keep the points' (Morton) order.
+        // Stable: equal cells keep the points' (spatial) order.
         points.par_sort_by_cached_key(|p| index.key(Vec3::from(p.position)));
         let mut ranges = Vec::new();
         let mut start = 0;
@@ -1211,6 +1237,27 @@ mod tests {
         let mut s = Scratch::default();
         for x in [Vec3::splat(50.0), Vec3::splat(f32::NAN)] {
             assert_eq!(fine.irradiance(x, Vec3::Y, 30, 0.5, &mut s).0, Color::ZERO);
+        }
+    }
+
+    /// A map without a tree (nor a Morton order) picks its cache points
+    /// along its grid's cells: still spread evenly, so that lookups all over
+    /// the surface find a point near them and the irradiance there.
+    #[test]
+    fn a_grid_only_map_spreads_its_cache_points() {
+        let photons = uniform_floor(21, 100_000);
+        let map = PhotonMap::build_for_photon_lookups(photons, 0.1);
+        assert!(map.grid.is_some() && map.tree.is_none() && map.tree_place.is_none());
+        let cache = IrradianceCache::build(&map, 4, 100, 1.0);
+        assert_eq!(cache.len(), 25_000);
+        let mut buf = Scratch::default();
+        for i in 0..10 {
+            for j in 0..10 {
+                let x = Vec3::new(0.2 + 0.4 * i as f32, 0.0, 0.2 + 0.4 * j as f32);
+                let cached = cache.lookup(x, Vec3::Y, &mut buf).x;
+                let direct = map.irradiance(x, Vec3::Y, 100, 1.0, &mut buf).0.x;
+                assert!((cached / direct - 1.0).abs() < 0.3, "at {x}: {cached} vs {direct}");
+            }
         }
     }
 
