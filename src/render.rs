@@ -153,8 +153,9 @@ pub struct Stats {
     pub edge_pixels: usize,
     pub first_nonfinite: Option<(u64, &'static str)>,
     pub photon_time: Duration,
-    /// The map build: kd-trees (Morton sort, trees, the maps' grids), then
-    /// the irradiance cache (estimates at photons, their grid and tree).
+    /// The map build: the photon maps (the caustic map's Morton sort and
+    /// kd-tree, both maps' grids), then the irradiance cache (estimates at
+    /// photons, their grid and tree).
     pub tree_time: Duration,
     pub cache_time: Duration,
     pub camera_time: Duration,

@@ -25,7 +25,7 @@ csv=${SCALING_CSV:-$(mktemp)}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-echo "round,threads,photon_pass_s,map_build_s,camera_pass_s,total_s,kd_trees_s,irradiance_cache_s" >"$csv"
+echo "round,threads,photon_pass_s,map_build_s,camera_pass_s,total_s,maps_s,irradiance_cache_s" >"$csv"
 for round in $(seq 1 "$reps"); do
     for t in "${threads[@]}"; do
         "$bin" --photons "$photons" --threads "$t" "$work/out.exr" 2>"$work/log" >/dev/null
@@ -41,7 +41,7 @@ done
 
 # Medians per thread count, then speedups against the 1-thread medians.
 echo
-echo "| threads | photon pass (s) | speedup | map build (s) | speedup | camera pass (s) | speedup | total (s) | speedup | kd-trees (s) | speedup | irradiance cache (s) | speedup |"
+echo "| threads | photon pass (s) | speedup | map build (s) | speedup | camera pass (s) | speedup | total (s) | speedup | maps (s) | speedup | irradiance cache (s) | speedup |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 awk -F, 'NR > 1 { n[$2]++; p[$2, n[$2]] = $3; m[$2, n[$2]] = $4; c[$2, n[$2]] = $5; s[$2, n[$2]] = $6; k[$2, n[$2]] = $7; e[$2, n[$2]] = $8 }
     function median(a, t, k,    i, j, v, x) {

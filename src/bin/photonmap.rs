@@ -427,7 +427,7 @@ fn summary(s: &Stats, settings: &Settings, write_time: std::time::Duration, tota
         100.0 * s.caustic_aimed_hits as f64 / s.caustic_emitted.max(1) as f64
     );
     eprintln!(
-        "  kd-trees:    {} + {} photons, {:.1} MB; irradiance cache {} points; radius caps {:.3} (global) {:.3} (caustic)",
+        "  photon maps: {} + {} photons, {:.1} MB; irradiance cache {} points; radius caps {:.3} (global) {:.3} (caustic)",
         s.global_stored,
         s.caustic_stored,
         s.map_bytes as f64 / 1e6,
@@ -442,7 +442,7 @@ fn summary(s: &Stats, settings: &Settings, write_time: std::time::Duration, tota
         mrays(s.photon_rays, s.photon_time)
     );
     eprintln!(
-        "  map build    {:>8.3} s  (kd-trees {:.3} s, irradiance cache {:.3} s)",
+        "  map build    {:>8.3} s  (maps {:.3} s, irradiance cache {:.3} s)",
         s.build_time().as_secs_f64(),
         s.tree_time.as_secs_f64(),
         s.cache_time.as_secs_f64()
