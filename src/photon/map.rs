@@ -200,15 +200,15 @@ impl CellGrid {
     /// wide (wider if the bounds would need too many), and the photons sorted by cell, keeping their
     /// order within a cell.
     /// Also returns, for each photon's place in the given order, its place
-    /// in the sorted one.
-    /// With `at_photons` (a map searched only at its own photons), no grid
-    /// where it would not pay.
+    /// in the sorted one (for a tree built in the given order).
+    /// With `at_photons` (a map searched only at its own photons, which has
+    /// no tree), no grid where it would not pay, and no places.
     fn build(
         photons: &[Photon],
         (lo, hi): (Vec3, Vec3),
         cell: f32,
         at_photons: bool,
-    ) -> Option<(Self, Vec<Photon>, Vec<u32>)> {
+    ) -> Option<(Self, Vec<Photon>, Option<Vec<u32>>)> {
         let extent = hi - lo;
         if photons.is_empty() || !(cell > 0.0) || !extent.is_finite() || !cell.is_finite() {
             return None;
@@ -253,10 +253,13 @@ impl CellGrid {
             start[c + 1] += start[c];
         }
         let sorted: Vec<Photon> = keys.par_iter().map(|&key| photons[key as u32 as usize]).collect();
-        let mut place = vec![0u32; keys.len()];
-        for (j, &key) in keys.iter().enumerate() {
-            place[key as u32 as usize] = j as u32;
-        }
+        let place = (!at_photons).then(|| {
+            let mut place = vec![0u32; keys.len()];
+            for (j, &key) in keys.iter().enumerate() {
+                place[key as u32 as usize] = j as u32;
+            }
+            place
+        });
         grid.start = start;
         Some((grid, sorted, place))
     }
@@ -420,19 +423,12 @@ impl PhotonMap {
         // fast from spatially sorted points) while the grid sorts by cell.
         let (lo, hi) = bounds(morton.iter().map(Photon::position));
         let tree = || Some(PointTree::build(morton.par_iter().map(|p| p.position())));
-        let grid = || cell.and_then(|c| CellGrid::build(&morton, (lo, hi), c, at_photons));
-        let (tree, gridded) = if at_photons {
-            let gridded = grid();
-            (if gridded.is_some() { None } else { tree() }, gridded)
-        } else {
-            rayon::join(tree, grid)
-        };
+        let grid = || cell.and_then(|c| CellGrid::build(&morton, (lo, hi), c, false));
+        let (tree, gridded) = rayon::join(tree, grid);
         let reach = if morton.is_empty() { 0.0 } else { lo.abs().max(hi.abs()).max_element() };
         let tree_pad = reach * 1e-5;
         match gridded {
-            Some((grid, photons, place)) => {
-                PhotonMap { photons, tree, tree_place: Some(place), grid: Some(grid), tree_pad }
-            }
+            Some((grid, photons, place)) => PhotonMap { photons, tree, tree_place: place, grid: Some(grid), tree_pad },
             None => PhotonMap { photons: morton, tree, tree_place: None, grid: None, tree_pad },
         }
     }
