@@ -75,6 +75,7 @@ pub const fn gamma(n: i32) -> f32 {
 /// The offset is the error box projected on the normal, then rounded one ulp
 /// further, so the new origin is provably on the correct side of the surface
 /// whatever the scene's scale.
+#[inline]
 pub fn offset_ray_origin(p: Vertex, p_err: Vec3, n: Vec3, dir: Direction) -> Vertex {
     let d = n.abs().dot(p_err);
     let mut offset = d * n;

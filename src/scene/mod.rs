@@ -34,6 +34,7 @@ pub struct Hit {
 
 impl Hit {
     /// The geometric normal turned to the side the ray `dir` arrived from.
+    #[inline]
     pub fn facing_normal(&self, dir: Vec3) -> Vec3 {
         if self.normal.dot(dir) < 0.0 {
             self.normal
@@ -50,6 +51,7 @@ impl Hit {
     }
 
     /// A ray leaving this hit along unit `dir`, with its departure record.
+    #[inline]
     pub fn spawn(&self, dir: Vec3) -> (Ray, Departure) {
         let origin = offset_ray_origin(self.point, self.p_err, self.normal, dir);
         (Ray::new(origin, dir), Departure { prim: self.prim, outward: dir.dot(self.normal) > 0.0 })
