@@ -85,6 +85,7 @@ impl AreaLight {
     }
 
     /// Uniform point on the surface (pdf 1 / area).
+    #[inline]
     pub fn sample_point(&self, u: Vec2) -> LightSample {
         let point = match self.surface {
             Emitting::Disk(disk) => {
@@ -215,11 +216,14 @@ impl Light {
     /// directional: uniform on the covering disk). With these pdfs every
     /// photon of N carries exactly power / N. The departure names the
     /// light's primitive, if it has one.
+    #[inline]
     pub fn emit(&self, u_pos: Vec2, u_dir: Vec2) -> (Ray, Option<Departure>) {
         match *self {
             Light::Area(a) => {
                 let p = a.sample_point(u_pos).point;
-                let dir = a.frame.to_world(cosine_hemisphere(u_dir)).normalize();
+                // Unit to rounding without normalising (see the photon
+                // pass's diffuse bounces): the first ray waits on it.
+                let dir = a.frame.to_world(cosine_hemisphere(u_dir));
                 (Ray::new(p, dir), Some(Departure { prim: a.prim, outward: true }))
             }
             Light::Point { position, .. } => (Ray::new(position, uniform_cone(u_dir, -1.0).normalize()), None),

@@ -433,6 +433,7 @@ impl Scene {
     /// A light chosen by `u` in [0, 1) in proportion to its power (largest
     /// channel), with the probability of that choice; `None` when no light
     /// emits anything.
+    #[inline]
     pub fn pick_light(&self, u: f32) -> Option<(&Light, f32)> {
         let total = *self.light_cdf.last()?;
         if !(total > 0.0) {
