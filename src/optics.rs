@@ -10,14 +10,16 @@ pub fn reflect(wi: Vec3) -> Vec3 {
 }
 
 /// Snell refraction of `wi` (with `wi.z > 0`) into the far side, `eta` being
-/// n_incident / n_transmitted. `None` on total internal reflection.
+/// n_incident / n_transmitted. `None` on total internal reflection. Unit to
+/// rounding where `wi` is (not normalised: every caller maps it to world
+/// space and normalises there).
 pub fn refract(wi: Vec3, eta: f32) -> Option<Vec3> {
     let sin2_t = eta * eta * (1.0 - wi.z * wi.z).max(0.0);
     if sin2_t >= 1.0 {
         return None;
     }
     let cos_t = (1.0 - sin2_t).sqrt();
-    Some(Vec3::new(-eta * wi.x, -eta * wi.y, -cos_t).normalize())
+    Some(Vec3::new(-eta * wi.x, -eta * wi.y, -cos_t))
 }
 
 /// Exact unpolarised Fresnel reflectance of a smooth dielectric boundary for
