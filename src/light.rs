@@ -155,6 +155,7 @@ impl Light {
 
     /// Whether every sample of the light certainly sends nothing to `p`: the
     /// emitting side of a one-sided area light faces away from it.
+    #[inline]
     pub fn faces_away(&self, p: Vertex) -> bool {
         match self {
             Light::Area(a) => (p - a.surface.anchor()).dot(a.surface.normal()) <= 0.0,
@@ -164,6 +165,7 @@ impl Light {
 
     /// Light arriving at `p` from the sample `u` of the light; `None` when
     /// that sample sends nothing towards `p`.
+    #[inline]
     pub fn incident(&self, p: Vertex, u: Vec2) -> Option<Incident> {
         match *self {
             Light::Area(a) => {

@@ -205,6 +205,7 @@ pub struct GlassBranches {
     pub refracted: Option<(Vec3, f32)>,
 }
 
+#[inline]
 pub fn glass_branches(hit: &Hit, ray: &Ray, ior: f32) -> GlassBranches {
     let frame = Frame::from_normal(hit.facing_normal(ray.dir));
     let wi = frame.to_local(-ray.dir);

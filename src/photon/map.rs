@@ -279,6 +279,7 @@ impl CellGrid {
     /// the box misses it); `None` where the box is not finite. The box is
     /// padded by a relative 1e-5 so that rounding cannot leave out a photon
     /// at distance `r`.
+    #[inline]
     fn cell_box(&self, x: Vec3, r: f32) -> Option<([i32; 3], [i32; 3])> {
         let pad = r * 1e-5 + (x - self.lo).abs().max_element() * 1e-6;
         let lo = (x - (r + pad) - self.lo) * self.inv_cell;
@@ -809,6 +810,7 @@ impl CellIndex {
         self.slots[i] = CellSlot { key, start, end };
     }
 
+    #[inline]
     fn range(&self, x: Vec3) -> Option<(u32, u32)> {
         if self.slots.is_empty() {
             return None;
@@ -919,6 +921,7 @@ impl IrradianceCache {
     }
 
     /// Starts fetching the table slot a lookup at `x` will read first.
+    #[inline]
     pub fn prefetch_cell(&self, x: Vec3) {
         if let Some(key) = self.cells.key(x).filter(|_| !self.cells.slots.is_empty()) {
             prefetch(&self.cells.slots[self.cells.home(key)]);
@@ -927,6 +930,7 @@ impl IrradianceCache {
 
     /// Finds `x`'s cell (after [`Self::prefetch_cell`] had time to bring in
     /// its slot) and starts fetching its points, for [`Self::lookup_in`].
+    #[inline]
     pub fn locate(&self, x: Vec3) -> CellRange {
         let range = self.cells.range(x);
         if let Some((start, end)) = range {
