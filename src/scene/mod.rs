@@ -470,7 +470,7 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampling::{next_2d, stream, uniform_cone, Domain};
+    use crate::sampling::{cosine_hemisphere, next_2d, stream, uniform_cone, Domain};
 
     /// Rays spawned from surfaces of the default scene, in both hemispheres
     /// and at grazing angles, never re-hit their own surface near the origin,
@@ -487,14 +487,20 @@ mod tests {
                 -4.0 + 8.0 * next_2d(&mut rng).x,
                 -4.0 + 8.0 * next_2d(&mut rng).y,
             );
-            let Some(hit) = scene.intersect(&Ray::new(o, uniform_cone(next_2d(&mut rng), -1.0)), None) else {
+            let arriving = uniform_cone(next_2d(&mut rng), -1.0);
+            let Some(hit) = scene.intersect(&Ray::new(o, arriving), None) else {
                 continue;
             };
-            for grazing in [false, true] {
+            for kind in 0..3 {
                 let mut d = uniform_cone(next_2d(&mut rng), -1.0);
-                if grazing {
+                if kind == 1 {
                     // Nearly tangent to the surface, on either side.
                     d = (d - hit.normal * d.dot(hit.normal) * 0.9999).normalize();
+                } else if kind == 2 {
+                    // A photon's diffuse bounce as the pass makes it: the
+                    // frame's image of a cosine sample, not renormalised.
+                    let n = hit.facing_normal(arriving);
+                    d = crate::math::Frame::from_normal(n).to_world(cosine_hemisphere(next_2d(&mut rng)));
                 }
                 let (ray, dep) = hit.spawn(d);
                 if let Some(next) = scene.intersect(&ray, Some(dep)) {
