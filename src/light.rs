@@ -223,8 +223,8 @@ impl Light {
         match *self {
             Light::Area(a) => {
                 let p = a.sample_point(u_pos).point;
-                // Unit to rounding without normalising (see the photon
-                // pass's diffuse bounces): the first ray waits on it.
+                // Unit to rounding without normalising (`Frame::to_world`):
+                // the first ray waits on it.
                 let dir = a.frame.to_world(cosine_hemisphere(u_dir));
                 (Ray::new(p, dir), Some(Departure { prim: a.prim, outward: true }))
             }

@@ -135,7 +135,7 @@ fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> Option<(Ray, Option
                 Light::Directional { .. } => unreachable!("handled above"),
             };
             let (axis, cos_max) = cone_towards(origin, chosen.center, chosen.radius);
-            // Unit to rounding without normalising (see the diffuse bounces).
+            // Unit to rounding without normalising (`Frame::to_world`).
             let dir = Frame::from_normal(axis).to_world(uniform_cone(next_2d(rng), cos_max));
             // The direction lies in the chosen cone by construction (a test
             // could deny it by rounding at the rim and leave a zero pdf); the
