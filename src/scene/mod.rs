@@ -480,7 +480,9 @@ mod tests {
     fn spawned_rays_never_rehit_their_own_surface() {
         let scene = Scene::tncg15(Eye::One);
         let mut rng = stream(8, Domain::Camera, 4);
-        let mut checked = 0;
+        // Rays spawned back to the side they arrived from (in a closed room)
+        // that met nothing, and rays that met the sphere they left.
+        let (mut back, mut escaped, mut sphere_rehits) = (0, 0, 0);
         for _ in 0..20_000 {
             let o = Vec3::new(
                 1.0 + 10.0 * next_2d(&mut rng).x,
@@ -503,9 +505,16 @@ mod tests {
                     d = crate::math::Frame::from_normal(n).to_world(cosine_hemisphere(next_2d(&mut rng)));
                 }
                 let (ray, dep) = hit.spawn(d);
-                if let Some(next) = scene.intersect(&ray, Some(dep)) {
-                    checked += 1;
+                let arrival_side = d.dot(hit.facing_normal(arriving)) > 0.0;
+                back += arrival_side as u32;
+                let next = scene.intersect(&ray, Some(dep));
+                // Every origin lies inside the room, so the side a ray
+                // arrived from is enclosed: a ray going back must meet
+                // something (a miss: it slipped through its own surface).
+                escaped += (arrival_side && next.is_none()) as u32;
+                if let Some(next) = next {
                     if next.prim == hit.prim {
+                        sphere_rehits += 1;
                         let Shape::Sphere(s) = scene.prims[hit.prim as usize].shape else {
                             panic!("re-hit flat primitive {} at t = {}", hit.prim, next.t)
                         };
@@ -525,8 +534,10 @@ mod tests {
                 }
             }
         }
-        // Half the directions leave the room through the wall they start on.
-        assert!(checked > 15_000, "{checked}");
+        assert_eq!(escaped, 0, "{escaped} of {back} rays spawned back to their arrival side met nothing");
+        // Half the directions go back (kind 2 always does).
+        assert!(back > 30_000, "{back}");
+        assert!(sphere_rehits > 100, "the sphere's chords were checked {sphere_rehits} times");
     }
 
     #[test]
