@@ -174,21 +174,26 @@ pub fn direct_light(
             continue;
         }
         let mut light_sum = Color::ZERO;
-        for s in 0..count {
-            let Some(inc) = light.incident(hit.point, stratified_2d(s, count, next_2d(ctx.rng))) else {
-                continue;
-            };
-            let cos_x = n.dot(inc.dir);
-            if !(cos_x > 0.0) {
-                continue;
+        // Samples two at a time: both are drawn before either shadow ray
+        // is cast, so the processor works out the second (a chain of a
+        // division, a square root and another division) while the first
+        // ray is traced. The random numbers are drawn in the same order.
+        let mut s = 0;
+        while s < count {
+            let mut pair = [None; 2];
+            for (j, slot) in pair.iter_mut().enumerate().take((count - s) as usize) {
+                let u = stratified_2d(s + j as u32, count, next_2d(ctx.rng));
+                *slot = light.incident(hit.point, u).map(|inc| (n.dot(inc.dir), inc)).filter(|&(c, _)| c > 0.0);
             }
-            let (shadow, dep) = hit.spawn(inc.dir);
-            ctx.tally.rays += 1;
-            let t_max = inc.target.map_or(f32::INFINITY, |p| (p - shadow.origin).length());
-            if scene.occluded(&shadow, Some(dep), t_max, inc.prim) {
-                continue;
+            s += 2;
+            for (cos_x, inc) in pair.into_iter().flatten() {
+                let (shadow, dep) = hit.spawn(inc.dir);
+                ctx.tally.rays += 1;
+                let t_max = inc.target.map_or(f32::INFINITY, |p| (p - shadow.origin).length());
+                if !scene.occluded(&shadow, Some(dep), t_max, inc.prim) {
+                    light_sum += brdf(inc.dir) * inc.intensity * cos_x;
+                }
             }
-            light_sum += brdf(inc.dir) * inc.intensity * cos_x;
         }
         sum += light_sum / count.max(1) as f32;
     }
