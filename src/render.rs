@@ -553,8 +553,8 @@ fn sample_index(pass: u64, pixel: u64) -> u64 {
 /// of their own. Each pixel has its own random stream per pass, so rows can
 /// run on any thread in any order.
 ///
-/// The rim pixels are found once (by the probes of the first pass that
-/// `rims` reaches empty) and kept: they are a property of the scene and the
+/// The rim pixels are found once, by the probes of the first pass given
+/// an empty `rims`, and kept: they are a property of the scene and the
 /// image, not of a pass's photons. Which pixels take the split estimate
 /// changes only its noise, not its mean. Found again every pass, the
 /// probes (four camera rays a pixel) were 16-24% of a progressive pass's

@@ -510,7 +510,7 @@ mod tests {
                 let next = scene.intersect(&ray, Some(dep));
                 // Every origin lies inside the room, so the side a ray
                 // arrived from is enclosed: a ray going back must meet
-                // something (a miss: it slipped through its own surface).
+                // something (a miss: it leaked out of the room).
                 escaped += (arrival_side && next.is_none()) as u32;
                 if let Some(next) = next {
                     if next.prim == hit.prim {
