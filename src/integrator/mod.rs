@@ -178,14 +178,12 @@ pub fn direct_light(
         // is cast, so the processor works out the second (a chain of a
         // division, a square root and another division) while the first
         // ray is traced. The random numbers are drawn in the same order.
-        let mut s = 0;
-        while s < count {
+        for s in (0..count).step_by(2) {
             let mut pair = [None; 2];
             for (j, slot) in pair.iter_mut().enumerate().take((count - s) as usize) {
                 let u = stratified_2d(s + j as u32, count, next_2d(ctx.rng));
                 *slot = light.incident(hit.point, u).map(|inc| (n.dot(inc.dir), inc)).filter(|&(c, _)| c > 0.0);
             }
-            s += 2;
             for (cos_x, inc) in pair.into_iter().flatten() {
                 let (shadow, dep) = hit.spawn(inc.dir);
                 ctx.tally.rays += 1;
