@@ -54,14 +54,29 @@ fn parent_dir(path: &Path) -> PathBuf {
 /// linear radiance as 32-bit floats; PNG and PPM hold the tone-mapped view.
 pub fn write(path: &Path, film: &Film, tonemap: ToneMap, exposure: f32) -> Result<()> {
     let format = check_writable(path)?;
+    atomically(path, |tmp| match format {
+        Format::Exr => write_exr(tmp, film),
+        Format::Png | Format::Ppm => write_rgb8(tmp, film, tonemap, exposure, format),
+    })
+}
+
+/// Writes 8-bit RGB pixels (row-major, row 0 at the top) as PNG or PPM, by
+/// `path`'s extension.
+pub fn write_rgb8_image(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<()> {
+    let format = check_writable(path)?;
+    if format == Format::Exr {
+        return Err(Error::Invalid(format!("{}: an 8-bit picture is written as .png or .ppm", path.display())));
+    }
+    atomically(path, |tmp| encode_rgb8(tmp, width, height, rgb, format))
+}
+
+/// Runs `write` on a temporary file beside `path`, then renames it over
+/// `path`; the temporary file is removed if anything fails.
+fn atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let tmp = parent_dir(path).join(format!(".{name}.{}.tmp", std::process::id()));
-    let written = match format {
-        Format::Exr => write_exr(&tmp, film),
-        Format::Png | Format::Ppm => write_rgb8(&tmp, film, tonemap, exposure, format),
-    };
-    let result =
-        written.and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::Io { path: path.to_owned(), source: e }));
+    let result = write(&tmp)
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::Io { path: path.to_owned(), source: e }));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
@@ -90,7 +105,11 @@ fn write_exr(tmp: &Path, film: &Film) -> Result<()> {
 }
 
 fn write_rgb8(tmp: &Path, film: &Film, tonemap: ToneMap, exposure: f32, format: Format) -> Result<()> {
-    let buf = image::RgbImage::from_raw(film.width, film.height, film.to_rgb8(tonemap, exposure))
+    encode_rgb8(tmp, film.width, film.height, film.to_rgb8(tonemap, exposure), format)
+}
+
+fn encode_rgb8(tmp: &Path, width: u32, height: u32, rgb: Vec<u8>, format: Format) -> Result<()> {
+    let buf = image::RgbImage::from_raw(width, height, rgb)
         .ok_or_else(|| Error::Encode { path: tmp.to_owned(), message: "image size mismatch".into() })?;
     let fmt = if format == Format::Png { image::ImageFormat::Png } else { image::ImageFormat::Pnm };
     buf.save_with_format(tmp, fmt).map_err(|e| Error::Encode { path: tmp.to_owned(), message: e.to_string() })

@@ -2,7 +2,9 @@
 //! photon mapping.
 //! A thin layer: parse and check the options, render, write, summarise.
 
-use clap::Parser;
+mod compare;
+
+use clap::{Parser, Subcommand};
 use photonmap::error::Error;
 use photonmap::film::ToneMap;
 use photonmap::metrics::compare;
@@ -21,9 +23,25 @@ use std::time::Instant;
     version,
     about,
     allow_negative_numbers = true,
-    after_help = "Examples: photonmap --photons 1e6 out.exr -o out.png\n          photonmap --scene scenes/tncg15.toml out.exr"
+    args_conflicts_with_subcommands = true,
+    after_help = "Examples: photonmap --photons 1e6 out.exr -o out.png\n          photonmap --scene scenes/tncg15.toml out.exr\n          photonmap compare out.exr ref.exr"
 )]
 struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    #[command(flatten)]
+    render: RenderArgs,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Score an image against a reference (RMSE, relMSE, bias, windows, speckles).
+    Compare(compare::Args),
+}
+
+/// Rendering (the default command).
+#[derive(clap::Args, Debug)]
+struct RenderArgs {
     /// Render this scene file (TOML, notes/scene-format.md) instead of the
     /// built-in room; its camera, resolution and rays_per_pixel_edge are the
     /// defaults of --width, --height and --spp.
@@ -194,7 +212,11 @@ fn parse_exposure(s: &str) -> Result<f32, String> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match run(cli) {
+    let result = match cli.command {
+        Some(Command::Compare(args)) => compare::run(args),
+        None => run(cli.render),
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("photonmap: error: {e}");
@@ -203,7 +225,7 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(cli: Cli) -> Result<(), Error> {
+fn run(cli: RenderArgs) -> Result<(), Error> {
     let outputs: Vec<PathBuf> = cli.outputs.iter().chain(&cli.more_outputs).cloned().collect();
     if outputs.is_empty() {
         return Err(Error::Invalid("no output file given (e.g. photonmap out.exr)".into()));

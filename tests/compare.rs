@@ -1,0 +1,137 @@
+//! `photonmap compare`: known differences give known numbers through the
+//! command line, windows are scored, size rules hold, nothing is lost.
+
+use photonmap::film::Film;
+use photonmap::math::Color;
+use photonmap::output::write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn photonmap(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_photonmap")).args(args).output().expect("run photonmap")
+}
+
+fn scratch_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn exr(dir: &Path, name: &str, w: u32, h: u32, f: impl Fn(u32, u32) -> f32) -> String {
+    let film = Film { width: w, height: h, pixels: (0..w * h).map(|i| Color::splat(f(i % w, i / w))).collect() };
+    let path = dir.join(name);
+    write(&path, &film, Default::default(), 1.0).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+fn json(o: &Output) -> serde_json::Value {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).expect("compare --json prints JSON")
+}
+
+/// A test twice the reference's size whose 2x2 blocks average to the
+/// reference plus 0.1, and plus 0.4 in a window: RMSE, bias and the
+/// window's numbers are the known ones.
+#[test]
+fn a_known_difference_gives_the_known_numbers() {
+    let dir = scratch_dir("compare-known");
+    let reference = exr(&dir, "ref.exr", 20, 10, |_, _| 0.5);
+    let test = exr(&dir, "test.exr", 40, 20, |x, y| {
+        let spot = (6..10).contains(&(x / 2)) && (2..4).contains(&(y / 2));
+        let base = if spot { 0.9 } else { 0.6 };
+        // +-0.05 within each 2x2 block: averaged away by the reduction.
+        base + if (x + y) % 2 == 0 { 0.05 } else { -0.05 }
+    });
+    let v = json(&photonmap(&["compare", &test, &reference, "--json", "--window", "spot=2:4,6:10"]));
+    assert_eq!(v["factor"], 2);
+    let whole = &v["whole"];
+    let want = ((8.0 * 0.16 + 192.0 * 0.01) / 200.0f64).sqrt();
+    assert!((whole["rmse"].as_f64().unwrap() - want).abs() < 1e-6, "{whole}");
+    assert!((whole["mean_ref"].as_f64().unwrap() - 0.5).abs() < 1e-6);
+    let spot = &v["windows"][0];
+    assert_eq!(spot["name"], "spot");
+    assert_eq!(spot["pixels"], 8);
+    assert!((spot["rmse"].as_f64().unwrap() - 0.4).abs() < 1e-6, "{spot}");
+    assert!((spot["bias"].as_f64().unwrap() - 0.8).abs() < 1e-6, "{spot}");
+    assert!((spot["relmse"].as_f64().unwrap() - 0.16 / 0.26).abs() < 1e-6, "{spot}");
+    assert_eq!(v["nan_count"], 0);
+    // The table names the window too.
+    let o = photonmap(&["compare", &test, &reference, "--window", "spot=2:4,6:10"]);
+    assert!(o.status.success() && String::from_utf8_lossy(&o.stdout).contains("spot"));
+}
+
+#[test]
+fn sizes_that_are_not_a_multiple_are_refused() {
+    let dir = scratch_dir("compare-sizes");
+    let reference = exr(&dir, "ref.exr", 20, 10, |_, _| 0.5);
+    for (w, h) in [(30, 10), (40, 10), (10, 5), (21, 10)] {
+        let test = exr(&dir, &format!("t{w}x{h}.exr"), w, h, |_, _| 0.5);
+        let o = photonmap(&["compare", &test, &reference]);
+        assert!(!o.status.success(), "{w}x{h} accepted");
+        assert!(String::from_utf8_lossy(&o.stderr).contains("cannot be compared"), "{w}x{h}");
+    }
+    let test = exr(&dir, "t.exr", 20, 10, |_, _| 0.5);
+    let o = photonmap(&["compare", &test, &reference, "--window", "0:11,0:5"]);
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("outside"));
+    let o = photonmap(&["compare", &test, &reference, "--window", "5:2,0:5"]);
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("--window"));
+}
+
+/// The difference picture is written at the reference's size, red where
+/// the test is brighter and blue where darker; it may not replace an input.
+#[test]
+fn the_difference_picture_is_signed_and_never_replaces_an_input() {
+    let dir = scratch_dir("compare-diff");
+    let reference = exr(&dir, "ref.exr", 8, 4, |_, _| 0.5);
+    let test = exr(&dir, "test.exr", 16, 8, |x, _| if x < 8 { 0.7 } else { 0.3 });
+    let png = dir.join("diff.png");
+    let v = json(&photonmap(&["compare", &test, &reference, "--json", "--diff", png.to_str().unwrap()]));
+    assert!((v["diff_scale"].as_f64().unwrap() - 0.2).abs() < 1e-5, "{v}");
+    let img = image::open(&png).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (8, 4));
+    let (left, right) = (img.get_pixel(0, 0).0, img.get_pixel(7, 3).0);
+    assert!(left[0] == 255 && left[2] < 255, "{left:?}");
+    assert!(right[2] == 255 && right[0] < 255, "{right:?}");
+    let before = std::fs::read(&reference).unwrap();
+    let o = photonmap(&["compare", &test, &reference, "--diff", &reference]);
+    assert!(!o.status.success());
+    assert_eq!(std::fs::read(&reference).unwrap(), before);
+}
+
+/// `--reference` scores a render with the same code: its JSON equals
+/// `compare`'s on the written image.
+#[test]
+fn render_reference_and_compare_agree() {
+    let dir = scratch_dir("compare-reference");
+    let out = dir.join("r.exr");
+    let reference = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/default_e1_200.exr");
+    let o = photonmap(&[
+        "--photons",
+        "2e4",
+        "--width",
+        "200",
+        "--height",
+        "200",
+        "--spp",
+        "1",
+        "--quiet",
+        "--reference",
+        reference.to_str().unwrap(),
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rendered: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let v = json(&photonmap(&[
+        "compare",
+        out.to_str().unwrap(),
+        reference.to_str().unwrap(),
+        "--json",
+        "--window",
+        "173:193,126:157",
+    ]));
+    let close = |a: &serde_json::Value, b: &serde_json::Value| (a.as_f64().unwrap() - b.as_f64().unwrap()).abs() < 1e-6;
+    assert!(close(&rendered["rmse"], &v["whole"]["rmse"]), "{rendered} vs {v}");
+    assert!(close(&rendered["caustic_rmse"], &v["windows"][0]["rmse"]), "{rendered} vs {v}");
+    assert!(close(&rendered["mean_x"], &v["whole"]["mean_test"]));
+}
