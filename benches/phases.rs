@@ -2,7 +2,8 @@
 //! `cargo bench --bench phases` (figures in notes/performance.md).
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use photonmap::photon::map::{IrradianceCache, PhotonMap, Scratch};
+use photonmap::photon::irradiance_cache::IrradianceCache;
+use photonmap::photon::map::{PhotonMap, Scratch};
 use photonmap::photon::trace::{trace_pass, Pass};
 use photonmap::progress::Mode;
 use photonmap::render::{cache_stride, render, Settings, GLOBAL_GRID_CELL, GLOBAL_RADIUS_FRACTION};

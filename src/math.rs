@@ -110,15 +110,6 @@ fn nudge(x: f32, towards: f32) -> f32 {
     f32::from_bits((next & moves) | (bits & !moves))
 }
 
-/// `x.floor() as i32` for every f32 (saturating, NaN to 0), inline:
-/// without SSE4.1 (the default x86-64 target) `f32::floor` is a library
-/// call, and grid lookups make millions of them.
-#[inline]
-pub fn floor_i32(x: f32) -> i32 {
-    let t = x as i32;
-    t.saturating_sub(((t as f32) > x) as i32)
-}
-
 /// Largest component, used for Russian roulette on RGB weights.
 pub fn max_component(c: Color) -> f32 {
     c.x.max(c.y).max(c.z)
@@ -149,42 +140,6 @@ mod tests {
             }
         }
         assert!(worst < 1e-6, "worst |length - 1| = {worst:e}");
-    }
-
-    #[test]
-    fn floor_i32_is_floor_then_cast() {
-        let mut rng = crate::sampling::stream(9, crate::sampling::Domain::Camera, 0);
-        let special = [
-            0.0f32,
-            -0.0,
-            0.5,
-            -0.5,
-            1.0,
-            -1.0,
-            0.99999994,
-            -0.99999994,
-            1e-40,
-            -1e-40,
-            2147483520.0,
-            -2147483648.0,
-            2147483648.0,
-            -2147483904.0,
-            3e9,
-            -3e9,
-            f32::MAX,
-            f32::MIN,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-            8388607.5,
-            -8388607.5,
-            16777217.0,
-        ];
-        let random = (0..1_000_000).map(|_| f32::from_bits(rand::RngExt::random::<u32>(&mut rng)));
-        let small = (-200_000..200_000).map(|i| i as f32 * 0.013);
-        for x in special.into_iter().chain(random).chain(small) {
-            assert_eq!(floor_i32(x), x.floor() as i32, "{x:e}");
-        }
     }
 
     #[test]

@@ -156,7 +156,11 @@ pub enum Mismatch {
 /// The integer factor by which `test` is larger than `reference` on both axes.
 pub fn reduction_factor(test: (u32, u32), reference: (u32, u32)) -> Result<u32, Mismatch> {
     let mismatch = Mismatch::Size(test.0, test.1, reference.0, reference.1);
-    if reference.0 == 0 || reference.1 == 0 || !test.0.is_multiple_of(reference.0) || !test.1.is_multiple_of(reference.1) {
+    if reference.0 == 0
+        || reference.1 == 0
+        || !test.0.is_multiple_of(reference.0)
+        || !test.1.is_multiple_of(reference.1)
+    {
         return Err(mismatch);
     }
     let f = test.0 / reference.0;
@@ -381,7 +385,8 @@ impl Metrics {
 /// sizes do not compare.
 pub fn compare(test: &Film, reference: &Film) -> Option<Metrics> {
     let window = Window::default_caustic(reference.width);
-    let windows = if reference.width.is_multiple_of(200) && reference.height == reference.width { vec![window] } else { vec![] };
+    let windows =
+        if reference.width.is_multiple_of(200) && reference.height == reference.width { vec![window] } else { vec![] };
     compare_images(test, reference, &windows).ok().map(|c| Metrics::from_comparison(&c))
 }
 

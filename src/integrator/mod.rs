@@ -11,7 +11,8 @@ pub mod whitted;
 
 use crate::math::{Color, Frame, Ray};
 use crate::optics::{fresnel_dielectric, reflect, refract};
-use crate::photon::map::{CellRange, Scratch};
+use crate::photon::irradiance_cache::CellRange;
+use crate::photon::map::Scratch;
 use crate::sampling::{next_2d, stratified_2d, Rng};
 use crate::scene::{Hit, Scene};
 use glam::Vec3;

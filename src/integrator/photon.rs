@@ -19,7 +19,8 @@
 use super::{direct_light, glass_branches, CausticMemo, Context, Integrator, Part, PendingRead};
 use crate::material::{Material, Phong};
 use crate::math::{max_component, Color, Frame, Ray};
-use crate::photon::map::{IrradianceCache, PhotonMap};
+use crate::photon::irradiance_cache::IrradianceCache;
+use crate::photon::map::PhotonMap;
 use crate::sampling::{cosine_hemisphere, next_2d, stratified_2d};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;

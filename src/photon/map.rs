@@ -1,31 +1,26 @@
-//! Photon maps: kd-trees over photon positions (kiddo; the only module that
-//! names it) and the density estimates read from them.
+//! Photon maps and the density estimates read from them (Jensen 2001,
+//! ch. 7): the k nearest photons within a radius cap, found through a grid
+//! of cells ([`super::grid`]) or the kd-tree ([`super::kdtree`]).
 //!
-//! Positions go into the tree rotated by a fixed generic rotation: photons
-//! on axis-aligned walls share one coordinate exactly, which makes kd-tree
-//! splits degenerate and queries slow (shared/research/ecosystem.md §2);
-//! distances are unchanged by a rotation. Photons are stored in Morton order
-//! so that neighbours in space are neighbours in memory; the renderer's maps
-//! are then sorted by the cells of a uniform grid sized for their lookups,
-//! through which most lookups go instead of the tree. A map searched only
-//! at its own photons (the global map) has no tree where its grid pays, and
-//! then no Morton order either: its grid sorts the photons as traced.
+//! Photons are stored in Morton order so that neighbours in space are
+//! neighbours in memory; the renderer's maps are then sorted by the cells
+//! of a uniform grid sized for their lookups, through which most lookups go
+//! instead of the tree. A map searched only at its own photons (the global
+//! map) has no tree where its grid pays, and then no Morton order either:
+//! its grid sorts the photons as traced.
 
-use super::{quantize_normal, Photon, PhotonBlocks};
-use crate::math::{floor_i32, Color};
-use glam::{EulerRot, Mat3, Vec3};
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use super::grid::{CellGrid, GRID_CELLS_PER_CAP, GRID_MAX_ROWS, GRID_MAX_SCAN};
+use super::kdtree::{found, unpack, PointTree};
+use super::{prefetch, Photon, PhotonBlocks};
+use crate::math::Color;
+use glam::Vec3;
 use rayon::prelude::*;
 use std::f32::consts::PI;
-
-/// Grid cells of the irradiance cache's index, as a fraction of the lookup
-/// radius (twice the median estimate radius).
-const CELL_FRACTION: f32 = 0.75;
 
 /// Photons whose stored normal is further than this (cosine) from the query
 /// normal lie on another surface (the wall in a corner, the far side of a
 /// thin object) and are left out of the estimate.
-const NORMAL_COSINE: f32 = 0.9;
+pub(crate) const NORMAL_COSINE: f32 = 0.9;
 
 /// Scratch space a thread reuses for every query (no allocation per lookup),
 /// with the squared radius its last k-nearest search needed: neighbouring
@@ -34,7 +29,7 @@ const NORMAL_COSINE: f32 = 0.9;
 pub struct Scratch {
     /// Photons found, as [`found`] keys: the first `found` (the vector only
     /// grows, so a search writes into it without clearing it first).
-    buf: Vec<u64>,
+    pub(crate) buf: Vec<u64>,
     found: usize,
     /// Keys to select the k-th nearest among, leaving `buf`'s order.
     select: Vec<u64>,
@@ -49,69 +44,8 @@ impl Scratch {
     }
 }
 
-fn rotation() -> Mat3 {
-    Mat3::from_euler(EulerRot::XYZ, 0.61, 0.93, 0.37)
-}
-
-/// A point found at squared distance `d2` (not negative), as one integer
-/// whose order is that of (d2, index): the bits of a non-negative float
-/// order like the float. Ranking by index among equal distances makes the k
-/// nearest one set whatever order the search met them in, and sorting
-/// integers is cheaper than comparing pairs.
-#[inline]
-fn found(d2: f32, index: u32) -> u64 {
-    ((d2.max(0.0).to_bits() as u64) << 32) | index as u64
-}
-
-/// The squared distance and index of a [`found`] key.
-#[inline]
-fn unpack(key: u64) -> (f32, u32) {
-    (f32::from_bits((key >> 32) as u32), key as u32)
-}
-
-/// A kd-tree over points, with the rotation applied on the way in.
-struct PointTree {
-    tree: Option<ImmutableKdTree<f32, 3>>,
-    rot: Mat3,
-}
-
-impl PointTree {
-    fn build(points: impl IndexedParallelIterator<Item = Vec3>) -> Self {
-        let rot = rotation();
-        let pts: Vec<[f32; 3]> = points.map(|p| (rot * p).to_array()).collect();
-        // An empty map has no tree; queries on it find nothing.
-        let tree = if pts.is_empty() { None } else { ImmutableKdTree::new_from_slice(&pts).ok() };
-        PointTree { tree, rot }
-    }
-
-    /// (squared distance, index) of the nearest point, if any.
-    fn nearest(&self, x: Vec3) -> Option<(f32, u32)> {
-        self.tree.as_ref().map(|tree| {
-            let n = tree.query(&(self.rot * x).to_array()).nearest_one::<SquaredEuclidean<f32>>().execute();
-            (n.distance, n.item)
-        })
-    }
-
-    /// Calls `f` with the index of every point within sqrt(r2) of x.
-    fn visit(&self, x: Vec3, r2: f32, mut f: impl FnMut(u32)) {
-        if let Some(tree) = &self.tree {
-            tree.query(&(self.rot * x).to_array()).within::<SquaredEuclidean<f32>>(r2).unsorted().visit(|n| f(n.item));
-        }
-    }
-
-    /// Pushes (squared distance, index) of every point within sqrt(r2) of x.
-    fn within(&self, x: Vec3, r2: f32, buf: &mut Vec<u64>) {
-        if let Some(tree) = &self.tree {
-            tree.query(&(self.rot * x).to_array())
-                .within::<SquaredEuclidean<f32>>(r2)
-                .unsorted()
-                .visit(|n| buf.push(found(n.distance, n.item)));
-        }
-    }
-}
-
 /// The smallest box holding the points (min > max when there are none).
-fn bounds(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
+pub(crate) fn bounds(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
     points.fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(p), hi.max(p)))
 }
 
@@ -164,185 +98,6 @@ fn morton_sorted(photons: &PhotonBlocks) -> Vec<Photon> {
         .collect()
 }
 
-/// A uniform grid over the map's bounds whose cells hold contiguous ranges
-/// of the photons (sorted by cell, rows along x, so a row of cells is one
-/// range). A lookup reads a few rows of photons in memory order instead of
-/// descending the kd-tree, which visits many leaves for ~100 photons (77%
-/// of the caustic estimates need more than half the cap; the global map's
-/// cells are sized for its much smaller radii). Where the rows hold too
-/// many photons (the caustic's focus) the tree answers. A lookup whose
-/// rows are all empty finds nothing without either.
-struct CellGrid {
-    lo: Vec3,
-    inv_cell: f32,
-    dims: [i32; 3],
-    /// `start[c]..start[c + 1]`: the photons of cell `c` (x fastest).
-    start: Vec<u32>,
-}
-
-/// Cells at most (4 bytes each); a larger grid gets wider cells.
-const GRID_MAX_CELLS: f32 = 4_194_304.0;
-
-/// Grid cells per lookup radius cap: the rows a lookup at the cap reads
-/// cover (2 + 1/2)^2 r^2 of a surface on average, 1.3x the 4 r^2 a square
-/// around the disk would, in at most 5 x 5 rows.
-const GRID_CELLS_PER_CAP: f32 = 2.0;
-
-/// Rows a grid lookup reads at most (more: the tree answers).
-const GRID_MAX_ROWS: usize = 64;
-
-/// Photons a grid lookup scans at most (more: the tree answers, as it is
-/// faster than a scan of ~2,000 photons).
-const GRID_MAX_SCAN: u32 = 2048;
-
-impl CellGrid {
-    /// The grid for `photons` (within bounds `(lo, hi)`) with cells `cell`
-    /// wide (wider if the bounds would need too many), and the photons sorted by cell, keeping their
-    /// order within a cell.
-    /// Also returns, for each photon's place in the given order, its place
-    /// in the sorted one (for a tree built in the given order).
-    /// With `at_photons` (a map searched only at its own photons, which has
-    /// no tree), no grid where it would not pay, and no places.
-    fn build(
-        photons: &[Photon],
-        (lo, hi): (Vec3, Vec3),
-        cell: f32,
-        at_photons: bool,
-    ) -> Option<(Self, Vec<Photon>, Option<Vec<u32>>)> {
-        let extent = hi - lo;
-        if photons.is_empty() || !(cell > 0.0) || !extent.is_finite() || !cell.is_finite() {
-            return None;
-        }
-        // Widen the cells until the grid is small enough. (Scaling by the
-        // cube root of the excess undershoots on flat extents: a floor
-        // 1e5 wide with 5 mm cells would have kept 2e9 cells.)
-        let cells = |c: f32| ((extent / c).floor() + 1.0).element_product();
-        let mut cell = cell;
-        while cells(cell) > GRID_MAX_CELLS {
-            cell *= 1.25;
-        }
-        let d = (extent / cell).as_ivec3() + 1;
-        let mut grid = CellGrid { lo, inv_cell: 1.0 / cell, dims: [d.x, d.y, d.z], start: Vec::new() };
-        // Sorted by (cell, position in the order given: Morton, or as
-        // traced): that order survives within cells, and the sort runs on
-        // every thread (a serial counting sort of the global map's 4.9 M
-        // photons took 0.3 s).
-        let n_cells = (d.x * d.y * d.z) as usize;
-        let cell_index: Vec<u32> = photons.par_iter().map(|p| grid.index(grid.cell_of(p.position())) as u32).collect();
-        let mut start = vec![0u32; n_cells + 1];
-        for &c in &cell_index {
-            start[c as usize + 1] += 1;
-        }
-        if at_photons {
-            // Searches at the photons themselves read, around a photon's
-            // own cell, a few cells like it: where a photon's cell holds
-            // GRID_MAX_SCAN / 9 photons on average, most would go to the
-            // tree anyway (the global map at 1e7 photons), and the grid
-            // would cost its sort and memory for nothing.
-            let typical =
-                cell_index.par_iter().map(|&c| start[c as usize + 1] as f64).sum::<f64>() / photons.len() as f64;
-            if 9.0 * typical > GRID_MAX_SCAN as f64 {
-                return None;
-            }
-        }
-        let mut keys: Vec<u64> =
-            cell_index.par_iter().enumerate().map(|(i, &c)| ((c as u64) << 32) | i as u64).collect();
-        drop(cell_index);
-        keys.par_sort_unstable();
-        for c in 0..n_cells {
-            start[c + 1] += start[c];
-        }
-        let sorted: Vec<Photon> = keys.par_iter().map(|&key| photons[key as u32 as usize]).collect();
-        let place = (!at_photons).then(|| {
-            let mut place = vec![0u32; keys.len()];
-            for (j, &key) in keys.iter().enumerate() {
-                place[key as u32 as usize] = j as u32;
-            }
-            place
-        });
-        grid.start = start;
-        Some((grid, sorted, place))
-    }
-
-    /// The cell holding `x`, clamped to the grid.
-    fn cell_of(&self, x: Vec3) -> [i32; 3] {
-        let c = (x - self.lo) * self.inv_cell;
-        [0, 1, 2].map(|a| floor_i32(c[a]).clamp(0, self.dims[a] - 1))
-    }
-
-    fn index(&self, c: [i32; 3]) -> usize {
-        ((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]) as usize
-    }
-
-    /// The cells (first and last on each axis) that meet the box of
-    /// half-width `r` around `x`, clamped to the grid (first > last where
-    /// the box misses it); `None` where the box is not finite. The box is
-    /// padded by a relative 1e-5 so that rounding cannot leave out a photon
-    /// at distance `r`.
-    #[inline]
-    fn cell_box(&self, x: Vec3, r: f32) -> Option<([i32; 3], [i32; 3])> {
-        let pad = r * 1e-5 + (x - self.lo).abs().max_element() * 1e-6;
-        let lo = (x - (r + pad) - self.lo) * self.inv_cell;
-        let hi = (x + (r + pad) - self.lo) * self.inv_cell;
-        if !(lo.is_finite() && hi.is_finite()) {
-            return None;
-        }
-        let (mut a, mut b) = ([0i32; 3], [0i32; 3]);
-        for ax in 0..3 {
-            a[ax] = floor_i32(lo[ax]).max(0);
-            b[ax] = floor_i32(hi[ax]).min(self.dims[ax] - 1);
-            if a[ax] > b[ax] {
-                return Some(([0; 3], [-1; 3]));
-            }
-        }
-        Some((a, b))
-    }
-
-    /// The photons of each non-empty row of cells in `cell_box`, in index
-    /// order.
-    fn each_row(&self, (a, b): ([i32; 3], [i32; 3]), mut f: impl FnMut(u32, u32)) {
-        for z in a[2]..=b[2] {
-            for y in a[1]..=b[1] {
-                let row = self.index([0, y, z]);
-                let (s, e) = (self.start[row + a[0] as usize], self.start[row + b[0] as usize + 1]);
-                if e > s {
-                    f(s, e);
-                }
-            }
-        }
-    }
-
-    /// The ranges of photons in the rows of cells that meet the box of
-    /// half-width `r` around `x`, and their total length; `None` when there
-    /// are more than [`GRID_MAX_ROWS`] rows or the box is not finite.
-    fn rows(&self, x: Vec3, r: f32, rows: &mut [(u32, u32); GRID_MAX_ROWS]) -> Option<(usize, u32)> {
-        let (a, b) = self.cell_box(x, r)?;
-        if ((b[1] - a[1] + 1) * (b[2] - a[2] + 1)) as usize > GRID_MAX_ROWS {
-            return None;
-        }
-        let (mut n, mut total) = (0, 0);
-        self.each_row((a, b), |s, e| {
-            rows[n] = (s, e);
-            n += 1;
-            total += e - s;
-        });
-        Some((n, total))
-    }
-
-    /// The squared radius that would hold ~`k` of the `total` photons in
-    /// the rows around `x` at radius `r` if they were spread evenly over a
-    /// plane through the rows' box (a guess for the search's speed only:
-    /// the answer does not depend on it); `None` where there is none.
-    fn crowded_radius2(&self, x: Vec3, r: f32, total: u32, k: usize) -> Option<f32> {
-        let (a, b) = self.cell_box(x, r)?;
-        let mut sides = [0, 1, 2].map(|ax| (b[ax] - a[ax] + 1).max(0) as f32 / self.inv_cell);
-        sides.sort_by(f32::total_cmp);
-        let area = sides[1] * sides[2];
-        let r2 = 1.5 * k as f32 * area / (PI * total as f32);
-        (r2 > 0.0 && r2.is_finite()).then_some(r2)
-    }
-}
-
 /// A photon map: the photons, a kd-tree over their positions, and, when
 /// built with one, a grid of the photons' cells (`CellGrid`). A map
 /// searched only at its own photons (the global map, read by the
@@ -359,11 +114,11 @@ impl CellGrid {
 pub struct PhotonMap {
     photons: Vec<Photon>,
     /// `None`: the grid answers every search.
-    tree: Option<PointTree>,
+    pub(crate) tree: Option<PointTree>,
     /// Where the tree's items (places in Morton order) are in `photons`,
     /// when the grid sorted them by cell.
-    tree_place: Option<Vec<u32>>,
-    grid: Option<CellGrid>,
+    pub(crate) tree_place: Option<Vec<u32>>,
+    pub(crate) grid: Option<CellGrid>,
     /// How much farther than asked the tree searches: the rotation's
     /// rounding moves a distance by far less.
     tree_pad: f32,
@@ -443,7 +198,7 @@ impl PhotonMap {
     /// The photons in a spatially coherent order: Morton order, or, for a
     /// map built without a tree (searched through its grid alone), the
     /// grid's cell order. A tree forced on later is built in this order.
-    fn spatial_order(&self) -> impl IndexedParallelIterator<Item = &Photon> + '_ {
+    pub(crate) fn spatial_order(&self) -> impl IndexedParallelIterator<Item = &Photon> + '_ {
         (0..self.photons.len() as u32).into_par_iter().map(move |m| &self.photons[self.tree_item(m) as usize])
     }
 
@@ -710,282 +465,10 @@ impl ConeEstimate {
     }
 }
 
-/// Irradiance precomputed at a subset of the global photons (Christensen
-/// 1999): final-gather rays then read one nearby value instead of running a
-/// k-nearest estimate each.
-///
-/// Gather rays land anywhere in the scene, so their lookups share no cache
-/// lines, and a kd-tree nearest-neighbour search over the points cost ~1 µs
-/// each (a quarter of the default camera pass, notes/performance.md). The
-/// points are therefore also bucketed by the cell of a uniform grid (cells
-/// hashed, each cell's points contiguous): a lookup reads its own cell's few
-/// points and takes the nearest one facing like the query; only where the
-/// cell holds none does it search the tree.
-pub struct IrradianceCache {
-    points: Vec<CachePoint>,
-    tree: PointTree,
-    cells: CellIndex,
-    /// Squared search radius of a lookup.
-    lookup_r2: f32,
-}
-
-#[derive(Clone, Copy, Debug)]
-struct CachePoint {
-    position: [f32; 3],
-    irradiance: [f32; 3],
-    normal: [i8; 4],
-}
-
-impl CachePoint {
-    fn faces(&self, n: Vec3) -> bool {
-        Vec3::new(self.normal[0] as f32, self.normal[1] as f32, self.normal[2] as f32).dot(n) >= NORMAL_COSINE * 127.0
-    }
-}
-
-/// A hint to the processor to bring `value`'s cache line in; nothing else.
-#[inline(always)]
-fn prefetch<T>(value: &T) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch has no effect on memory or registers; the address
-    // is that of a live reference.
-    unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>((value as *const T).cast());
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = value;
-}
-
-/// Cells of a uniform grid, hashed: each occupied cell's range of points
-/// (sorted by cell). An open-addressing table of 16-byte slots, so that a
-/// probe usually costs one cache line (a `HashMap` reads its control bytes
-/// and its slots from two places).
-struct CellIndex {
-    lo: Vec3,
-    inv_cell: f32,
-    slots: Vec<CellSlot>,
-    /// log2 of the slot count.
-    bits: u32,
-}
-
-/// The range of a query point's cell in the cache's points, if it has one.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct CellRange(Option<(u32, u32)>);
-
-#[derive(Clone, Copy)]
-struct CellSlot {
-    key: u64,
-    start: u32,
-    end: u32,
-}
-
-/// Bits per axis of a cell key; coarser cells where a grid would need more.
-const CELL_BITS: u32 = 21;
-/// Keys use 63 bits, so this one marks an empty slot.
-const EMPTY: u64 = u64::MAX;
-
-impl CellIndex {
-    fn key(&self, x: Vec3) -> Option<u64> {
-        let c = (x - self.lo) * self.inv_cell;
-        // Outside the grid (or not finite): no cell. Inside, the cell is
-        // the coordinates' floor, which for these non-negative values the
-        // cast to an integer takes (f32::floor is a library call here).
-        if !(c.min_element() >= 0.0 && c.max_element() < (1u32 << CELL_BITS) as f32) {
-            return None;
-        }
-        Some(c.x as u64 | ((c.y as u64) << CELL_BITS) | ((c.z as u64) << (2 * CELL_BITS)))
-    }
-
-    /// The first slot to probe: Fibonacci hashing (one multiply) spreads
-    /// the packed coordinates well enough.
-    fn home(&self, key: u64) -> usize {
-        (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.bits)) as usize
-    }
-
-    fn insert(&mut self, key: u64, start: u32, end: u32) {
-        let mask = self.slots.len() - 1;
-        let mut i = self.home(key);
-        while self.slots[i].key != EMPTY {
-            i = (i + 1) & mask;
-        }
-        self.slots[i] = CellSlot { key, start, end };
-    }
-
-    #[inline]
-    fn range(&self, x: Vec3) -> Option<(u32, u32)> {
-        if self.slots.is_empty() {
-            return None;
-        }
-        let key = self.key(x)?;
-        let mask = self.slots.len() - 1;
-        let mut i = self.home(key);
-        loop {
-            let slot = self.slots[i];
-            if slot.key == key {
-                return Some((slot.start, slot.end));
-            }
-            if slot.key == EMPTY {
-                return None;
-            }
-            i = (i + 1) & mask;
-        }
-    }
-}
-
-impl IrradianceCache {
-    /// Precomputes irradiance at every `stride`-th photon of `map` from its
-    /// `k` nearest within `r_max`.
-    pub fn build(map: &PhotonMap, stride: usize, k: usize, r_max: f32) -> Self {
-        let stride = stride.max(1);
-        // Rayon hands each piece of work it splits off a fresh scratch, and
-        // with no hint a search starts at the radius cap: ~55,000 photons in
-        // the default global map, and at 16 threads thousands of such pieces.
-        // They start instead from the radius one estimate needed (the
-        // answers do not depend on it).
-        let hint = map
-            .photons
-            .get(map.len() / 2)
-            .map_or(0.0, |p| map.irradiance(p.position(), p.surface_normal(), k, r_max, &mut Scratch::default()).1);
-        // Every stride-th photon along the map's spatial order (Morton, or
-        // cell by cell): spread evenly over the surfaces.
-        let computed: Vec<(CachePoint, f32)> = map
-            .spatial_order()
-            .step_by(stride)
-            .map_init(
-                || Scratch::with_hint(hint),
-                |buf, p| {
-                    let n = p.surface_normal();
-                    let (e, r2) = map.irradiance(p.position(), n, k, r_max, buf);
-                    let point = CachePoint {
-                        position: p.position().to_array(),
-                        irradiance: e.to_array(),
-                        normal: quantize_normal(n),
-                    };
-                    (point, r2)
-                },
-            )
-            .collect();
-        // Search as far as twice the median estimate radius: far enough to
-        // find a cached point on the same surface almost everywhere, near
-        // enough to stay within the blur the estimates already have.
-        let mut radii: Vec<f32> = computed.iter().map(|c| c.1).collect();
-        let median_r2 = if radii.is_empty() {
-            0.0
-        } else {
-            let mid = radii.len() / 2;
-            *radii.select_nth_unstable_by(mid, f32::total_cmp).1
-        };
-        let lookup_r2 = (4.0 * median_r2).min(r_max * r_max);
-        let mut points: Vec<CachePoint> = computed.into_iter().map(|c| c.0).collect();
-        let cells = Self::bucket(&mut points, lookup_r2.sqrt() * CELL_FRACTION);
-        let tree = PointTree::build(points.par_iter().map(|c| Vec3::from(c.position)));
-        IrradianceCache { points, tree, cells, lookup_r2 }
-    }
-
-    /// Sorts the points by grid cell and indexes each cell's range.
-    fn bucket(points: &mut [CachePoint], cell: f32) -> CellIndex {
-        let (lo, hi) = bounds(points.iter().map(|p| Vec3::from(p.position)));
-        let extent = (hi - lo).max_element();
-        let fine_enough = extent / ((1u32 << CELL_BITS) - 2) as f32;
-        let cell = if cell.is_finite() && cell > fine_enough { cell } else { fine_enough.max(f32::MIN_POSITIVE) };
-        let mut index = CellIndex { lo, inv_cell: 1.0 / cell, slots: Vec::new(), bits: 0 };
-        if points.is_empty() || !extent.is_finite() || !index.inv_cell.is_finite() {
-            return index;
-        }
-        // Stable: equal cells keep the points' (spatial) order.
-        points.par_sort_by_cached_key(|p| index.key(Vec3::from(p.position)));
-        let mut ranges = Vec::new();
-        let mut start = 0;
-        while start < points.len() {
-            let key = index.key(Vec3::from(points[start].position));
-            let end = start + points[start..].iter().take_while(|p| index.key(Vec3::from(p.position)) == key).count();
-            if let Some(key) = key {
-                ranges.push((key, start as u32, end as u32));
-            }
-            start = end;
-        }
-        // At most half full: probes stay short.
-        index.bits = (2 * ranges.len()).next_power_of_two().trailing_zeros().max(1);
-        index.slots = vec![CellSlot { key: EMPTY, start: 0, end: 0 }; 1 << index.bits];
-        for (key, start, end) in ranges {
-            index.insert(key, start, end);
-        }
-        index
-    }
-
-    pub fn len(&self) -> usize {
-        self.points.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.points.is_empty()
-    }
-
-    /// Starts fetching the table slot a lookup at `x` will read first.
-    #[inline]
-    pub fn prefetch_cell(&self, x: Vec3) {
-        if let Some(key) = self.cells.key(x).filter(|_| !self.cells.slots.is_empty()) {
-            prefetch(&self.cells.slots[self.cells.home(key)]);
-        }
-    }
-
-    /// Finds `x`'s cell (after [`Self::prefetch_cell`] had time to bring in
-    /// its slot) and starts fetching its points, for [`Self::lookup_in`].
-    #[inline]
-    pub fn locate(&self, x: Vec3) -> CellRange {
-        let range = self.cells.range(x);
-        if let Some((start, end)) = range {
-            prefetch(&self.points[start as usize]);
-            prefetch(&self.points[end as usize - 1]);
-        }
-        CellRange(range)
-    }
-
-    /// Irradiance of a cached point near `x`, within the lookup radius, on
-    /// a surface facing like `n`: the nearest such point in `x`'s grid cell,
-    /// else the nearest anywhere; zero where no photon came near.
-    pub fn lookup(&self, x: Vec3, n: Vec3, scratch: &mut Scratch) -> Color {
-        self.lookup_in(x, n, CellRange(self.cells.range(x)), scratch)
-    }
-
-    /// [`Self::lookup`] with `x`'s cell already found by [`Self::locate`].
-    pub fn lookup_in(&self, x: Vec3, n: Vec3, cell: CellRange, scratch: &mut Scratch) -> Color {
-        if let Some((start, end)) = cell.0 {
-            let mut best: Option<(f32, &CachePoint)> = None;
-            for p in &self.points[start as usize..end as usize] {
-                let d2 = Vec3::from(p.position).distance_squared(x);
-                if d2 <= self.lookup_r2 && best.is_none_or(|b| d2 < b.0) && p.faces(n) {
-                    best = Some((d2, p));
-                }
-            }
-            if let Some((_, p)) = best {
-                return Vec3::from(p.irradiance);
-            }
-        }
-        // Almost always the nearest point is on the same surface; only near
-        // edges and corners is a wider search needed.
-        match self.tree.nearest(x) {
-            None => return Color::ZERO,
-            Some((d2, i)) if d2 <= self.lookup_r2 && self.points[i as usize].faces(n) => {
-                return Vec3::from(self.points[i as usize].irradiance);
-            }
-            _ => {}
-        }
-        let buf = &mut scratch.buf;
-        buf.clear();
-        self.tree.within(x, self.lookup_r2, buf);
-        let mut best: Option<(f32, u32)> = None;
-        for (d2, i) in buf.iter().map(|&key| unpack(key)) {
-            if best.is_none_or(|b| d2 < b.0) && self.points[i as usize].faces(n) {
-                best = Some((d2, i));
-            }
-        }
-        best.map_or(Color::ZERO, |(_, i)| Vec3::from(self.points[i as usize].irradiance))
-    }
-}
-
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+    use crate::photon::grid::GRID_MAX_CELLS;
 
     use crate::sampling::{next_2d, stream, Domain};
 
@@ -1204,7 +687,7 @@ mod tests {
 
     /// `n` photons of power 1 spread uniformly over the square [0, 4]^2 of
     /// the plane y = 0, facing +y (random stream `seed`).
-    fn uniform_floor(seed: u64, n: usize) -> Vec<Photon> {
+    pub(crate) fn uniform_floor(seed: u64, n: usize) -> Vec<Photon> {
         let mut rng = stream(seed, Domain::Camera, 0);
         (0..n)
             .map(|_| {
@@ -1243,117 +726,5 @@ mod tests {
         for x in [Vec3::splat(50.0), Vec3::splat(f32::NAN)] {
             assert_eq!(fine.irradiance(x, Vec3::Y, 30, 0.5, &mut s).0, Color::ZERO);
         }
-    }
-
-    /// A map without a tree (nor a Morton order) picks its cache points
-    /// along its grid's cells: still spread evenly, so that lookups all over
-    /// the surface find a point near them and the irradiance there.
-    #[test]
-    fn a_grid_only_map_spreads_its_cache_points() {
-        let photons = uniform_floor(21, 100_000);
-        let map = PhotonMap::build_for_photon_lookups(photons, 0.1);
-        assert!(map.grid.is_some() && map.tree.is_none() && map.tree_place.is_none());
-        let cache = IrradianceCache::build(&map, 4, 100, 1.0);
-        assert_eq!(cache.len(), 25_000);
-        let mut buf = Scratch::default();
-        for i in 0..10 {
-            for j in 0..10 {
-                let x = Vec3::new(0.2 + 0.4 * i as f32, 0.0, 0.2 + 0.4 * j as f32);
-                let cached = cache.lookup(x, Vec3::Y, &mut buf).x;
-                let direct = map.irradiance(x, Vec3::Y, 100, 1.0, &mut buf).0.x;
-                assert!((cached / direct - 1.0).abs() < 0.3, "at {x}: {cached} vs {direct}");
-            }
-        }
-    }
-
-    /// A map sorted by the grid's cells computes its cache at the same
-    /// photons (every stride-th along the Morton order) and finds the same
-    /// irradiance there (its sums run in another order: last bits only).
-    #[test]
-    fn irradiance_cache_is_the_same_with_a_grid() {
-        let mut rng = stream(18, Domain::Camera, 0);
-        let photons: Vec<Photon> = (0..50_000)
-            .map(|i| {
-                let u = next_2d(&mut rng) * 4.0;
-                match i % 2 {
-                    0 => Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y),
-                    _ => Photon::new(Vec3::new(0.0, u.x, u.y), Color::splat(0.5), Vec3::X),
-                }
-            })
-            .collect();
-        let plain = IrradianceCache::build(&PhotonMap::build(photons.clone()), 4, 50, 1.0);
-        let gridded_map = PhotonMap::build_with_grid(photons, Some(0.05));
-        assert!(gridded_map.grid.is_some());
-        let gridded = IrradianceCache::build(&gridded_map, 4, 50, 1.0);
-        let key = |c: &CachePoint| c.position.map(f32::to_bits);
-        let (mut a, mut b) = (plain.points.clone(), gridded.points.clone());
-        a.sort_by_key(key);
-        b.sort_by_key(key);
-        assert_eq!(a.len(), b.len());
-        for (p, q) in a.iter().zip(&b) {
-            assert_eq!(p.position, q.position);
-            for c in 0..3 {
-                let (x, y) = (p.irradiance[c], q.irradiance[c]);
-                assert!((x - y).abs() <= 1e-5 * x.abs().max(1e-30), "{x} vs {y}");
-            }
-        }
-    }
-
-    #[test]
-    fn irradiance_cache_agrees_with_direct_estimate() {
-        let photons = uniform_floor(12, 100_000);
-        let map = PhotonMap::build(photons);
-        let cache = IrradianceCache::build(&map, 4, 100, 1.0);
-        assert_eq!(cache.len(), 25_000);
-        let mut buf = Scratch::default();
-        let x = Vec3::new(2.0, 0.0, 2.0);
-        let direct = map.irradiance(x, Vec3::Y, 100, 1.0, &mut buf).0.x;
-        let cached = cache.lookup(x, Vec3::Y, &mut buf).x;
-        assert!((cached / direct - 1.0).abs() < 0.25, "{cached} {direct}");
-        assert!((direct / 6250.0 - 1.0).abs() < 0.2, "{direct}");
-        assert_eq!(cache.lookup(x, -Vec3::Y, &mut buf), Color::ZERO);
-    }
-
-    /// In a corner a lookup's grid cell holds points of both surfaces: each
-    /// query gets its own surface's irradiance, from its cell or, where the
-    /// cell holds only the other surface's points, from the tree. Every
-    /// answer is the irradiance of a point that faces the query and lies
-    /// within the lookup radius.
-    #[test]
-    fn irradiance_cache_keeps_surfaces_apart_in_a_corner() {
-        let mut rng = stream(13, Domain::Camera, 0);
-        // Floor y = 0 (power 1) and wall x = 0 (power 3), 4 x 4 each.
-        let photons: Vec<Photon> = (0..100_000)
-            .map(|i| {
-                let u = next_2d(&mut rng) * 4.0;
-                if i % 2 == 0 {
-                    Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y)
-                } else {
-                    Photon::new(Vec3::new(0.0, u.x, u.y), Color::splat(3.0), Vec3::X)
-                }
-            })
-            .collect();
-        let map = PhotonMap::build(photons);
-        let cache = IrradianceCache::build(&map, 4, 100, 1.0);
-        let mut buf = Scratch::default();
-        let (floor, wall) = (50_000.0 / 16.0, 3.0 * 50_000.0 / 16.0);
-        for i in 0..200 {
-            let d = 1e-3 + 0.4 * i as f32 / 200.0;
-            let z = 0.5 + 3.0 * (i % 17) as f32 / 17.0;
-            let on_floor = cache.lookup(Vec3::new(d, 0.0, z), Vec3::Y, &mut buf).x;
-            let on_wall = cache.lookup(Vec3::new(0.0, d, z), Vec3::X, &mut buf).x;
-            // Near the corner the estimates themselves lose up to half
-            // their disk; far from the other surface is all that is asked.
-            assert!(on_floor > 0.3 * floor && on_floor < 1.3 * floor, "floor at {d}: {on_floor}");
-            assert!(on_wall > 0.3 * wall && on_wall < 1.3 * wall, "wall at {d}: {on_wall}");
-        }
-        // Points facing the other way exist nowhere: nothing is returned.
-        assert_eq!(cache.lookup(Vec3::new(0.2, 0.0, 2.0), -Vec3::Y, &mut buf), Color::ZERO);
-        // Outside the grid and far from every point: zero, not a far value.
-        assert_eq!(cache.lookup(Vec3::new(50.0, 50.0, 50.0), Vec3::Y, &mut buf), Color::ZERO);
-        assert_eq!(cache.lookup(Vec3::splat(f32::NAN), Vec3::Y, &mut buf), Color::ZERO);
-        // A cache over no photons answers zero everywhere.
-        let empty = IrradianceCache::build(&PhotonMap::build(Vec::new()), 4, 100, 1.0);
-        assert_eq!(empty.lookup(Vec3::new(0.2, 0.0, 2.0), Vec3::Y, &mut buf), Color::ZERO);
     }
 }

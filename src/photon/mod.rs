@@ -10,6 +10,9 @@
 //!   diffuse: the caustic map, read directly at visible surfaces.
 
 mod blocks;
+mod grid;
+pub mod irradiance_cache;
+mod kdtree;
 pub mod map;
 pub mod trace;
 
@@ -52,38 +55,28 @@ impl Photon {
     }
 }
 
-/// The nearest integer (halves away from zero) of a float within +-2^22,
-/// inline: `f32::round` is a library call on the default x86-64 target (no
-/// SSE4.1), and every stored photon rounds three values.
-#[inline]
-fn round(x: f32) -> i32 {
-    // Truncate, then step by the fraction (exact: |x| < 2^23). Adding 0.5
-    // before truncating would round 0.49999997 up.
-    let t = x as i32;
-    let frac = x - t as f32;
-    t + (frac >= 0.5) as i32 - (frac <= -0.5) as i32
-}
-
 /// A unit normal in three signed bytes (angle error below 0.5 degrees).
 pub fn quantize_normal(n: Vec3) -> [i8; 4] {
     let q = (n * 127.0).clamp(Vec3::splat(-127.0), Vec3::splat(127.0));
-    [round(q.x) as i8, round(q.y) as i8, round(q.z) as i8, 0]
+    [q.x.round() as i8, q.y.round() as i8, q.z.round() as i8, 0]
+}
+
+/// A hint to the processor to bring `value`'s cache line in; nothing else.
+#[inline(always)]
+pub(crate) fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch has no effect on memory or registers; the address
+    // is that of a live reference.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>((value as *const T).cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn inline_rounding_matches_round() {
-        for i in -40_000..40_000 {
-            for frac in [0.0f32, 0.25, 0.49999997, 0.5, 0.50000006, 0.75] {
-                let x = i as f32 + frac;
-                assert_eq!(round(x), x.round() as i32, "{x}");
-                assert_eq!(round(-x), (-x).round() as i32, "{}", -x);
-            }
-        }
-    }
 
     #[test]
     fn photon_is_28_bytes() {

@@ -1,0 +1,394 @@
+//! Irradiance precomputed at a subset of the global photons (Christensen
+//! 1999): final-gather rays read one nearby value instead of running a
+//! k-nearest estimate each.
+
+use super::kdtree::{unpack, PointTree};
+use super::map::{bounds, PhotonMap, Scratch, NORMAL_COSINE};
+use super::{prefetch, quantize_normal};
+use crate::math::Color;
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// Grid cells of the irradiance cache's index, as a fraction of the lookup
+/// radius (twice the median estimate radius).
+const CELL_FRACTION: f32 = 0.75;
+
+/// Irradiance precomputed at a subset of the global photons (Christensen
+/// 1999): final-gather rays then read one nearby value instead of running a
+/// k-nearest estimate each.
+///
+/// Gather rays land anywhere in the scene, so their lookups share no cache
+/// lines, and a kd-tree nearest-neighbour search over the points cost ~1 µs
+/// each (a quarter of the default camera pass, notes/performance.md). The
+/// points are therefore also bucketed by the cell of a uniform grid (cells
+/// hashed, each cell's points contiguous): a lookup reads its own cell's few
+/// points and takes the nearest one facing like the query; only where the
+/// cell holds none does it search the tree.
+pub struct IrradianceCache {
+    points: Vec<CachePoint>,
+    tree: PointTree,
+    cells: CellIndex,
+    /// Squared search radius of a lookup.
+    lookup_r2: f32,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct CachePoint {
+    position: [f32; 3],
+    irradiance: [f32; 3],
+    normal: [i8; 4],
+}
+
+impl CachePoint {
+    fn faces(&self, n: Vec3) -> bool {
+        Vec3::new(self.normal[0] as f32, self.normal[1] as f32, self.normal[2] as f32).dot(n) >= NORMAL_COSINE * 127.0
+    }
+}
+
+/// Cells of a uniform grid, hashed: each occupied cell's range of points
+/// (sorted by cell). An open-addressing table of 16-byte slots, so that a
+/// probe usually costs one cache line (a `HashMap` reads its control bytes
+/// and its slots from two places).
+struct CellIndex {
+    lo: Vec3,
+    inv_cell: f32,
+    slots: Vec<CellSlot>,
+    /// log2 of the slot count.
+    bits: u32,
+}
+
+/// The range of a query point's cell in the cache's points, if it has one.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CellRange(Option<(u32, u32)>);
+
+#[derive(Clone, Copy)]
+struct CellSlot {
+    key: u64,
+    start: u32,
+    end: u32,
+}
+
+/// Bits per axis of a cell key; coarser cells where a grid would need more.
+const CELL_BITS: u32 = 21;
+/// Keys use 63 bits, so this one marks an empty slot.
+const EMPTY: u64 = u64::MAX;
+
+impl CellIndex {
+    fn key(&self, x: Vec3) -> Option<u64> {
+        let c = (x - self.lo) * self.inv_cell;
+        // Outside the grid (or not finite): no cell. Inside, the cell is
+        // the coordinates' floor, which for these non-negative values the
+        // cast to an integer takes (f32::floor is a library call here).
+        if !(c.min_element() >= 0.0 && c.max_element() < (1u32 << CELL_BITS) as f32) {
+            return None;
+        }
+        Some(c.x as u64 | ((c.y as u64) << CELL_BITS) | ((c.z as u64) << (2 * CELL_BITS)))
+    }
+
+    /// The first slot to probe: Fibonacci hashing (one multiply) spreads
+    /// the packed coordinates well enough.
+    fn home(&self, key: u64) -> usize {
+        (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - self.bits)) as usize
+    }
+
+    fn insert(&mut self, key: u64, start: u32, end: u32) {
+        let mask = self.slots.len() - 1;
+        let mut i = self.home(key);
+        while self.slots[i].key != EMPTY {
+            i = (i + 1) & mask;
+        }
+        self.slots[i] = CellSlot { key, start, end };
+    }
+
+    #[inline]
+    fn range(&self, x: Vec3) -> Option<(u32, u32)> {
+        if self.slots.is_empty() {
+            return None;
+        }
+        let key = self.key(x)?;
+        let mask = self.slots.len() - 1;
+        let mut i = self.home(key);
+        loop {
+            let slot = self.slots[i];
+            if slot.key == key {
+                return Some((slot.start, slot.end));
+            }
+            if slot.key == EMPTY {
+                return None;
+            }
+            i = (i + 1) & mask;
+        }
+    }
+}
+
+impl IrradianceCache {
+    /// Precomputes irradiance at every `stride`-th photon of `map` from its
+    /// `k` nearest within `r_max`.
+    pub fn build(map: &PhotonMap, stride: usize, k: usize, r_max: f32) -> Self {
+        let stride = stride.max(1);
+        // Rayon hands each piece of work it splits off a fresh scratch, and
+        // with no hint a search starts at the radius cap: ~55,000 photons in
+        // the default global map, and at 16 threads thousands of such pieces.
+        // They start instead from the radius one estimate needed (the
+        // answers do not depend on it).
+        let hint = map
+            .photons()
+            .get(map.len() / 2)
+            .map_or(0.0, |p| map.irradiance(p.position(), p.surface_normal(), k, r_max, &mut Scratch::default()).1);
+        // Every stride-th photon along the map's spatial order (Morton, or
+        // cell by cell): spread evenly over the surfaces.
+        let computed: Vec<(CachePoint, f32)> = map
+            .spatial_order()
+            .step_by(stride)
+            .map_init(
+                || Scratch::with_hint(hint),
+                |buf, p| {
+                    let n = p.surface_normal();
+                    let (e, r2) = map.irradiance(p.position(), n, k, r_max, buf);
+                    let point = CachePoint {
+                        position: p.position().to_array(),
+                        irradiance: e.to_array(),
+                        normal: quantize_normal(n),
+                    };
+                    (point, r2)
+                },
+            )
+            .collect();
+        // Search as far as twice the median estimate radius: far enough to
+        // find a cached point on the same surface almost everywhere, near
+        // enough to stay within the blur the estimates already have.
+        let mut radii: Vec<f32> = computed.iter().map(|c| c.1).collect();
+        let median_r2 = if radii.is_empty() {
+            0.0
+        } else {
+            let mid = radii.len() / 2;
+            *radii.select_nth_unstable_by(mid, f32::total_cmp).1
+        };
+        let lookup_r2 = (4.0 * median_r2).min(r_max * r_max);
+        let mut points: Vec<CachePoint> = computed.into_iter().map(|c| c.0).collect();
+        let cells = Self::bucket(&mut points, lookup_r2.sqrt() * CELL_FRACTION);
+        let tree = PointTree::build(points.par_iter().map(|c| Vec3::from(c.position)));
+        IrradianceCache { points, tree, cells, lookup_r2 }
+    }
+
+    /// Sorts the points by grid cell and indexes each cell's range.
+    fn bucket(points: &mut [CachePoint], cell: f32) -> CellIndex {
+        let (lo, hi) = bounds(points.iter().map(|p| Vec3::from(p.position)));
+        let extent = (hi - lo).max_element();
+        let fine_enough = extent / ((1u32 << CELL_BITS) - 2) as f32;
+        let cell = if cell.is_finite() && cell > fine_enough { cell } else { fine_enough.max(f32::MIN_POSITIVE) };
+        let mut index = CellIndex { lo, inv_cell: 1.0 / cell, slots: Vec::new(), bits: 0 };
+        if points.is_empty() || !extent.is_finite() || !index.inv_cell.is_finite() {
+            return index;
+        }
+        // Stable: equal cells keep the points' (spatial) order.
+        points.par_sort_by_cached_key(|p| index.key(Vec3::from(p.position)));
+        let mut ranges = Vec::new();
+        let mut start = 0;
+        while start < points.len() {
+            let key = index.key(Vec3::from(points[start].position));
+            let end = start + points[start..].iter().take_while(|p| index.key(Vec3::from(p.position)) == key).count();
+            if let Some(key) = key {
+                ranges.push((key, start as u32, end as u32));
+            }
+            start = end;
+        }
+        // At most half full: probes stay short.
+        index.bits = (2 * ranges.len()).next_power_of_two().trailing_zeros().max(1);
+        index.slots = vec![CellSlot { key: EMPTY, start: 0, end: 0 }; 1 << index.bits];
+        for (key, start, end) in ranges {
+            index.insert(key, start, end);
+        }
+        index
+    }
+
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// Starts fetching the table slot a lookup at `x` will read first.
+    #[inline]
+    pub fn prefetch_cell(&self, x: Vec3) {
+        if let Some(key) = self.cells.key(x).filter(|_| !self.cells.slots.is_empty()) {
+            prefetch(&self.cells.slots[self.cells.home(key)]);
+        }
+    }
+
+    /// Finds `x`'s cell (after [`Self::prefetch_cell`] had time to bring in
+    /// its slot) and starts fetching its points, for [`Self::lookup_in`].
+    #[inline]
+    pub fn locate(&self, x: Vec3) -> CellRange {
+        let range = self.cells.range(x);
+        if let Some((start, end)) = range {
+            prefetch(&self.points[start as usize]);
+            prefetch(&self.points[end as usize - 1]);
+        }
+        CellRange(range)
+    }
+
+    /// Irradiance of a cached point near `x`, within the lookup radius, on
+    /// a surface facing like `n`: the nearest such point in `x`'s grid cell,
+    /// else the nearest anywhere; zero where no photon came near.
+    pub fn lookup(&self, x: Vec3, n: Vec3, scratch: &mut Scratch) -> Color {
+        self.lookup_in(x, n, CellRange(self.cells.range(x)), scratch)
+    }
+
+    /// [`Self::lookup`] with `x`'s cell already found by [`Self::locate`].
+    pub fn lookup_in(&self, x: Vec3, n: Vec3, cell: CellRange, scratch: &mut Scratch) -> Color {
+        if let Some((start, end)) = cell.0 {
+            let mut best: Option<(f32, &CachePoint)> = None;
+            for p in &self.points[start as usize..end as usize] {
+                let d2 = Vec3::from(p.position).distance_squared(x);
+                if d2 <= self.lookup_r2 && best.is_none_or(|b| d2 < b.0) && p.faces(n) {
+                    best = Some((d2, p));
+                }
+            }
+            if let Some((_, p)) = best {
+                return Vec3::from(p.irradiance);
+            }
+        }
+        // Almost always the nearest point is on the same surface; only near
+        // edges and corners is a wider search needed.
+        match self.tree.nearest(x) {
+            None => return Color::ZERO,
+            Some((d2, i)) if d2 <= self.lookup_r2 && self.points[i as usize].faces(n) => {
+                return Vec3::from(self.points[i as usize].irradiance);
+            }
+            _ => {}
+        }
+        let buf = &mut scratch.buf;
+        buf.clear();
+        self.tree.within(x, self.lookup_r2, buf);
+        let mut best: Option<(f32, u32)> = None;
+        for (d2, i) in buf.iter().map(|&key| unpack(key)) {
+            if best.is_none_or(|b| d2 < b.0) && self.points[i as usize].faces(n) {
+                best = Some((d2, i));
+            }
+        }
+        best.map_or(Color::ZERO, |(_, i)| Vec3::from(self.points[i as usize].irradiance))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::photon::map::tests::uniform_floor;
+    use crate::photon::Photon;
+    use crate::sampling::{next_2d, stream, Domain};
+
+    /// A map without a tree (nor a Morton order) picks its cache points
+    /// along its grid's cells: still spread evenly, so that lookups all over
+    /// the surface find a point near them and the irradiance there.
+    #[test]
+    fn a_grid_only_map_spreads_its_cache_points() {
+        let photons = uniform_floor(21, 100_000);
+        let map = PhotonMap::build_for_photon_lookups(photons, 0.1);
+        assert!(map.grid.is_some() && map.tree.is_none() && map.tree_place.is_none());
+        let cache = IrradianceCache::build(&map, 4, 100, 1.0);
+        assert_eq!(cache.len(), 25_000);
+        let mut buf = Scratch::default();
+        for i in 0..10 {
+            for j in 0..10 {
+                let x = Vec3::new(0.2 + 0.4 * i as f32, 0.0, 0.2 + 0.4 * j as f32);
+                let cached = cache.lookup(x, Vec3::Y, &mut buf).x;
+                let direct = map.irradiance(x, Vec3::Y, 100, 1.0, &mut buf).0.x;
+                assert!((cached / direct - 1.0).abs() < 0.3, "at {x}: {cached} vs {direct}");
+            }
+        }
+    }
+
+    /// A map sorted by the grid's cells computes its cache at the same
+    /// photons (every stride-th along the Morton order) and finds the same
+    /// irradiance there (its sums run in another order: last bits only).
+    #[test]
+    fn irradiance_cache_is_the_same_with_a_grid() {
+        let mut rng = stream(18, Domain::Camera, 0);
+        let photons: Vec<Photon> = (0..50_000)
+            .map(|i| {
+                let u = next_2d(&mut rng) * 4.0;
+                match i % 2 {
+                    0 => Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y),
+                    _ => Photon::new(Vec3::new(0.0, u.x, u.y), Color::splat(0.5), Vec3::X),
+                }
+            })
+            .collect();
+        let plain = IrradianceCache::build(&PhotonMap::build(photons.clone()), 4, 50, 1.0);
+        let gridded_map = PhotonMap::build_with_grid(photons, Some(0.05));
+        assert!(gridded_map.grid.is_some());
+        let gridded = IrradianceCache::build(&gridded_map, 4, 50, 1.0);
+        let key = |c: &CachePoint| c.position.map(f32::to_bits);
+        let (mut a, mut b) = (plain.points.clone(), gridded.points.clone());
+        a.sort_by_key(key);
+        b.sort_by_key(key);
+        assert_eq!(a.len(), b.len());
+        for (p, q) in a.iter().zip(&b) {
+            assert_eq!(p.position, q.position);
+            for c in 0..3 {
+                let (x, y) = (p.irradiance[c], q.irradiance[c]);
+                assert!((x - y).abs() <= 1e-5 * x.abs().max(1e-30), "{x} vs {y}");
+            }
+        }
+    }
+
+    #[test]
+    fn irradiance_cache_agrees_with_direct_estimate() {
+        let photons = uniform_floor(12, 100_000);
+        let map = PhotonMap::build(photons);
+        let cache = IrradianceCache::build(&map, 4, 100, 1.0);
+        assert_eq!(cache.len(), 25_000);
+        let mut buf = Scratch::default();
+        let x = Vec3::new(2.0, 0.0, 2.0);
+        let direct = map.irradiance(x, Vec3::Y, 100, 1.0, &mut buf).0.x;
+        let cached = cache.lookup(x, Vec3::Y, &mut buf).x;
+        assert!((cached / direct - 1.0).abs() < 0.25, "{cached} {direct}");
+        assert!((direct / 6250.0 - 1.0).abs() < 0.2, "{direct}");
+        assert_eq!(cache.lookup(x, -Vec3::Y, &mut buf), Color::ZERO);
+    }
+
+    /// In a corner a lookup's grid cell holds points of both surfaces: each
+    /// query gets its own surface's irradiance, from its cell or, where the
+    /// cell holds only the other surface's points, from the tree. Every
+    /// answer is the irradiance of a point that faces the query and lies
+    /// within the lookup radius.
+    #[test]
+    fn irradiance_cache_keeps_surfaces_apart_in_a_corner() {
+        let mut rng = stream(13, Domain::Camera, 0);
+        // Floor y = 0 (power 1) and wall x = 0 (power 3), 4 x 4 each.
+        let photons: Vec<Photon> = (0..100_000)
+            .map(|i| {
+                let u = next_2d(&mut rng) * 4.0;
+                if i % 2 == 0 {
+                    Photon::new(Vec3::new(u.x, 0.0, u.y), Color::ONE, Vec3::Y)
+                } else {
+                    Photon::new(Vec3::new(0.0, u.x, u.y), Color::splat(3.0), Vec3::X)
+                }
+            })
+            .collect();
+        let map = PhotonMap::build(photons);
+        let cache = IrradianceCache::build(&map, 4, 100, 1.0);
+        let mut buf = Scratch::default();
+        let (floor, wall) = (50_000.0 / 16.0, 3.0 * 50_000.0 / 16.0);
+        for i in 0..200 {
+            let d = 1e-3 + 0.4 * i as f32 / 200.0;
+            let z = 0.5 + 3.0 * (i % 17) as f32 / 17.0;
+            let on_floor = cache.lookup(Vec3::new(d, 0.0, z), Vec3::Y, &mut buf).x;
+            let on_wall = cache.lookup(Vec3::new(0.0, d, z), Vec3::X, &mut buf).x;
+            // Near the corner the estimates themselves lose up to half
+            // their disk; far from the other surface is all that is asked.
+            assert!(on_floor > 0.3 * floor && on_floor < 1.3 * floor, "floor at {d}: {on_floor}");
+            assert!(on_wall > 0.3 * wall && on_wall < 1.3 * wall, "wall at {d}: {on_wall}");
+        }
+        // Points facing the other way exist nowhere: nothing is returned.
+        assert_eq!(cache.lookup(Vec3::new(0.2, 0.0, 2.0), -Vec3::Y, &mut buf), Color::ZERO);
+        // Outside the grid and far from every point: zero, not a far value.
+        assert_eq!(cache.lookup(Vec3::new(50.0, 50.0, 50.0), Vec3::Y, &mut buf), Color::ZERO);
+        assert_eq!(cache.lookup(Vec3::splat(f32::NAN), Vec3::Y, &mut buf), Color::ZERO);
+        // A cache over no photons answers zero everywhere.
+        let empty = IrradianceCache::build(&PhotonMap::build(Vec::new()), 4, 100, 1.0);
+        assert_eq!(empty.lookup(Vec3::new(0.2, 0.0, 2.0), Vec3::Y, &mut buf), Color::ZERO);
+    }
+}
