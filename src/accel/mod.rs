@@ -9,74 +9,26 @@
 //! room is tested first: the wall a ray would reach bounds the search among
 //! the objects inside.
 
+mod bvh;
 pub mod enclosure;
 
 use crate::math::Ray;
 use crate::shape::{Departure, Shape, ShapeHit};
+use bvh::Bvh;
 use enclosure::Enclosure;
-use glam::{Vec3, Vec3A, Vec4};
 
-const BINS: usize = 16;
 /// Up to this many primitives a flat loop beats the hierarchy. With the
 /// room's walls in the enclosure, the tree over the 7 objects inside it
 /// takes random rays from 157 to 87 ns (notes/performance.md).
 pub const FLAT_LIMIT: usize = 2;
-const MAX_LEAF: usize = 4;
-
-#[derive(Clone, Copy, Debug)]
-struct Node {
-    min: Vec3,
-    max: Vec3,
-    /// Interior: index of the first of two adjacent children. Leaf: index of
-    /// the first primitive in leaf order.
-    first: u32,
-    /// Primitives in the leaf; 0 for interior nodes.
-    count: u32,
-}
-
-/// A node of the 4-wide hierarchy the traversal walks: four children's
-/// boxes in SIMD lanes, tested at once. It is the binary SAH tree with
-/// every other level folded in (nodes with the largest boxes opened
-/// first): random rays in the default room visit one node, not the
-/// binary tree's chain of two-box tests whose branches they mispredict.
-#[derive(Clone, Copy, Debug)]
-struct Node4 {
-    min: [Vec4; 3],
-    max: [Vec4; 3],
-    /// Interior child: its node. Leaf child: its first primitive in leaf order.
-    child: [u32; 4],
-    /// Primitives of a leaf child; 0 for an interior child.
-    count: [u32; 4],
-    /// Bit k set where lane k holds a child.
-    used: u32,
-}
-
-/// Entries the traversal stack holds. A node pushes at most three more
-/// than it pops, so 128 hold a path 42 nodes deep (a binary tree of ~84
-/// levels; the binary traversal's stack held 64); a full stack would drop
-/// far boxes rather than overrun.
-const STACK: usize = 128;
 
 pub struct Accel {
     /// Empty when the primitives are few enough to test them all.
-    nodes: Vec<Node4>,
+    bvh: Bvh,
     /// Shapes in leaf order, with their index in the scene (those of the
     /// enclosure left out).
     shapes: Vec<(Shape, u32)>,
     enclosure: Option<Enclosure>,
-}
-
-#[derive(Clone, Copy)]
-struct Item {
-    min: Vec3,
-    max: Vec3,
-    centroid: Vec3,
-    index: u32,
-}
-
-fn area(min: Vec3, max: Vec3) -> f32 {
-    let d = (max - min).max(Vec3::ZERO);
-    2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
 }
 
 impl Accel {
@@ -108,24 +60,12 @@ impl Accel {
         let rest: Vec<(Shape, u32)> =
             shapes.iter().enumerate().filter(|&(i, _)| inside(i)).map(|(i, s)| (*s, i as u32)).collect();
         if rest.len() <= flat_limit {
-            return Accel { nodes: Vec::new(), shapes: rest, enclosure };
+            return Accel { bvh: Bvh::build(&[]).0, shapes: rest, enclosure };
         }
-        let mut items: Vec<Item> = rest
-            .iter()
-            .map(|&(s, i)| {
-                let (min, max) = s.bounds();
-                Item { min, max, centroid: 0.5 * (min + max), index: i }
-            })
-            .collect();
-        let mut binary = Vec::with_capacity(2 * items.len().max(1));
-        binary.push(Node { min: Vec3::ZERO, max: Vec3::ZERO, first: 0, count: 0 });
-        let mut nodes = Vec::new();
-        if !items.is_empty() {
-            build(&mut binary, 0, &mut items, 0);
-            collapse(&binary, &mut nodes, 0);
-        }
-        let ordered = items.iter().map(|it| (shapes[it.index as usize], it.index)).collect();
-        Accel { nodes, shapes: ordered, enclosure }
+        let boxes: Vec<_> = rest.iter().map(|(s, _)| s.bounds()).collect();
+        let (bvh, order) = Bvh::build(&boxes);
+        let ordered = order.iter().map(|&i| rest[i as usize]).collect();
+        Accel { bvh, shapes: ordered, enclosure }
     }
 
     /// Where the ray meets the enclosure before `t_max` (never the face it
@@ -200,14 +140,12 @@ impl Accel {
         blocked
     }
 
-    /// Visits the leaves whose boxes the ray enters before `t_limit`, nearer
-    /// boxes first; `visit` may shrink `t_limit`, and returns true to stop.
+    /// Visits the shapes in the leaves whose boxes the ray enters before
+    /// `t_max`, nearer boxes first (all of them when there is no
+    /// hierarchy); `visit` may shrink the reach, and returns true to stop.
     fn traverse<'s>(&'s self, ray: &Ray, t_max: f32, mut visit: impl FnMut(&'s Shape, u32, &mut f32) -> bool) {
-        if self.shapes.is_empty() {
-            return;
-        }
-        let mut t_limit = t_max;
-        if self.nodes.is_empty() {
+        if self.bvh.is_empty() {
+            let mut t_limit = t_max;
             for (shape, index) in &self.shapes {
                 if visit(shape, *index, &mut t_limit) {
                     return;
@@ -215,209 +153,10 @@ impl Accel {
             }
             return;
         }
-        let inv = Vec3A::from(ray.dir).recip();
-        let origin = [Vec4::splat(ray.origin.x), Vec4::splat(ray.origin.y), Vec4::splat(ray.origin.z)];
-        let inv = [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)];
-        // Interior children to open later, (node, entry distance), nearest
-        // on top; made on the first push (a tree of one node never needs it,
-        // and zeroing it per ray cost more than the default room's rays).
-        let mut stack: Option<[(u32, f32); STACK]> = None;
-        let mut top = 0usize;
-        let mut node = 0u32;
-        loop {
-            let n = &self.nodes[node as usize];
-            let (t_in, t_out) = entries(n, origin, inv);
-            let mut hits =
-                (t_in.cmple(t_out) & t_in.cmple(Vec4::splat(t_limit)) & t_in.cmplt(Vec4::INFINITY)).bitmask() & n.used;
-            let t_in = t_in.to_array();
-            // The boxes entered, nearest first (on a tie, the lower lane).
-            let mut order = [0usize; 4];
-            let mut entered = 0;
-            while hits != 0 {
-                let k = hits.trailing_zeros() as usize;
-                hits &= hits - 1;
-                let mut j = entered;
-                while j > 0 && t_in[order[j - 1]] > t_in[k] {
-                    order[j] = order[j - 1];
-                    j -= 1;
-                }
-                order[j] = k;
-                entered += 1;
-            }
-            // Leaves now, nearest first: their hits prune what follows.
-            for &k in &order[..entered] {
-                let count = n.count[k];
-                if count > 0 && t_in[k] <= t_limit {
-                    let first = n.child[k] as usize;
-                    for (shape, index) in &self.shapes[first..first + count as usize] {
-                        if visit(shape, *index, &mut t_limit) {
-                            return;
-                        }
-                    }
-                }
-            }
-            // Interior children onto the stack, farthest first.
-            for &k in order[..entered].iter().rev() {
-                if n.count[k] == 0 && top < STACK {
-                    stack.get_or_insert([(0, 0.0); STACK])[top] = (n.child[k], t_in[k]);
-                    top += 1;
-                }
-            }
-            // Pop, skipping boxes that the shrinking closest hit now excludes.
-            loop {
-                let Some(stack) = stack.as_ref().filter(|_| top > 0) else { return };
-                top -= 1;
-                let (child, t) = stack[top];
-                if t <= t_limit {
-                    node = child;
-                    break;
-                }
-            }
-        }
+        self.bvh.traverse(ray, t_max, |leaf, t_limit| {
+            self.shapes[leaf].iter().any(|(shape, index)| visit(shape, *index, t_limit))
+        });
     }
-}
-
-/// Distances at which the ray enters and leaves each of the node's four
-/// boxes (0 for a box it starts in); a box is missed where the entry
-/// comes after the exit. A lane is NaN only from 0 * inf (a ray parallel to
-/// a slab, starting on its plane): such a slab constrains nothing, so a box
-/// is never dropped for it (at worst a box the ray only grazes is visited).
-#[inline(always)]
-fn entries(n: &Node4, origin: [Vec4; 3], inv: [Vec4; 3]) -> (Vec4, Vec4) {
-    let mut t_in = Vec4::ZERO;
-    let mut t_out = Vec4::INFINITY;
-    for a in 0..3 {
-        let t0 = (n.min[a] - origin[a]) * inv[a];
-        let t1 = (n.max[a] - origin[a]) * inv[a];
-        let (near, far) = (t0.min(t1), t0.max(t1));
-        t_in = t_in.max(Vec4::select(near.is_nan_mask(), Vec4::NEG_INFINITY, near));
-        t_out = t_out.min(Vec4::select(far.is_nan_mask(), Vec4::INFINITY, far));
-    }
-    // Widen the exit by a few ulps so rounding never drops a box a ray grazes.
-    (t_in, t_out * (1.0 + 2.0 * crate::math::gamma(3)))
-}
-
-/// Folds the binary tree under `root` into 4-wide nodes appended to `out`;
-/// returns the index of the node made for `root`. Of the binary nodes below
-/// a 4-wide node, the interior one with the largest box is opened first,
-/// until there are four children or only leaves.
-fn collapse(binary: &[Node], out: &mut Vec<Node4>, root: usize) -> u32 {
-    let mut kids = vec![root];
-    while kids.len() < 4 {
-        let open = kids
-            .iter()
-            .enumerate()
-            .filter(|&(_, &k)| binary[k].count == 0)
-            .max_by(|a, b| {
-                area(binary[*a.1].min, binary[*a.1].max).total_cmp(&area(binary[*b.1].min, binary[*b.1].max))
-            })
-            .map(|(i, _)| i);
-        let Some(i) = open else { break };
-        let first = binary[kids[i]].first as usize;
-        kids.splice(i..=i, [first, first + 1]);
-    }
-    let index = out.len();
-    out.push(Node4 { min: [Vec4::ZERO; 3], max: [Vec4::ZERO; 3], child: [0; 4], count: [0; 4], used: 0 });
-    let mut min = [[0.0f32; 4]; 3];
-    let mut max = [[0.0f32; 4]; 3];
-    let mut child = [0u32; 4];
-    let mut count = [0u32; 4];
-    for (lane, &k) in kids.iter().enumerate() {
-        let b = &binary[k];
-        for a in 0..3 {
-            min[a][lane] = b.min[a];
-            max[a][lane] = b.max[a];
-        }
-        (child[lane], count[lane]) = if b.count > 0 { (b.first, b.count) } else { (collapse(binary, out, k), 0) };
-    }
-    out[index] = Node4 {
-        min: min.map(Vec4::from_array),
-        max: max.map(Vec4::from_array),
-        child,
-        count,
-        used: (1u32 << kids.len()) - 1,
-    };
-    index as u32
-}
-
-fn build(nodes: &mut Vec<Node>, node: usize, items: &mut [Item], offset: u32) {
-    let (min, max) = items.iter().fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(a, b), it| {
-        (a.min(it.min), b.max(it.max))
-    });
-    let leaf = Node { min, max, first: offset, count: items.len() as u32 };
-    if items.len() <= 1 {
-        nodes[node] = leaf;
-        return;
-    }
-    let (cmin, cmax) = items.iter().fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(a, b), it| {
-        (a.min(it.centroid), b.max(it.centroid))
-    });
-    let extent = cmax - cmin;
-    let axis = if extent.x >= extent.y && extent.x >= extent.z {
-        0
-    } else if extent.y >= extent.z {
-        1
-    } else {
-        2
-    };
-    let mid = if extent[axis] > 0.0 {
-        // Binned SAH along the widest centroid axis.
-        let bin_of =
-            |it: &Item| (((it.centroid[axis] - cmin[axis]) / extent[axis] * BINS as f32) as usize).min(BINS - 1);
-        let mut counts = [0usize; BINS];
-        let mut bounds = [(Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)); BINS];
-        for it in items.iter() {
-            let b = bin_of(it);
-            counts[b] += 1;
-            bounds[b] = (bounds[b].0.min(it.min), bounds[b].1.max(it.max));
-        }
-        let mut best = (f32::INFINITY, 0usize);
-        for split in 1..BINS {
-            let side = |range: std::ops::Range<usize>| {
-                range.fold((0usize, Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(c, a, b), i| {
-                    (c + counts[i], a.min(bounds[i].0), b.max(bounds[i].1))
-                })
-            };
-            let (nl, al, bl) = side(0..split);
-            let (nr, ar, br) = side(split..BINS);
-            if nl == 0 || nr == 0 {
-                continue;
-            }
-            let cost = nl as f32 * area(al, bl) + nr as f32 * area(ar, br);
-            if cost < best.0 {
-                best = (cost, split);
-            }
-        }
-        let leaf_cost = items.len() as f32 * area(min, max);
-        if best.1 == 0 || (best.0 >= leaf_cost && items.len() <= MAX_LEAF) {
-            if items.len() <= MAX_LEAF {
-                nodes[node] = leaf;
-                return;
-            }
-            items.len() / 2
-        } else {
-            let mut i = 0;
-            for j in 0..items.len() {
-                if bin_of(&items[j]) < best.1 {
-                    items.swap(i, j);
-                    i += 1;
-                }
-            }
-            i
-        }
-    } else if items.len() <= MAX_LEAF {
-        nodes[node] = leaf;
-        return;
-    } else {
-        items.len() / 2
-    };
-    let first = nodes.len();
-    nodes.push(leaf);
-    nodes.push(leaf);
-    nodes[node] = Node { min, max, first: first as u32, count: 0 };
-    let (left, right) = items.split_at_mut(mid);
-    build(nodes, first, left, offset);
-    build(nodes, first + 1, right, offset + mid as u32);
 }
 
 #[cfg(test)]
@@ -577,7 +316,7 @@ mod tests {
         let torus = crate::scene::mesh::torus(glam::Vec3::ZERO, 2.0, 0.5, 100, 50);
         let shapes: Vec<Shape> = torus.iter().map(|[a, b, c]| Shape::Triangle(Triangle::new(*a, *b, *c))).collect();
         let tree = Accel::new(shapes.clone());
-        assert!(tree.nodes.len() > 100, "{} nodes", tree.nodes.len());
+        assert!(tree.bvh.len() > 100, "{} nodes", tree.bvh.len());
         let flat = Accel::with_flat_limit(shapes, usize::MAX);
         let mut rng = stream(23, Domain::Camera, 0);
         let mut hits = 0;
