@@ -1,0 +1,73 @@
+//! The CS475 assignment's transformed unit sphere (an ellipsoid under a
+//! non-uniform scale).
+
+use super::{ShapeHit, Sphere};
+use crate::math::{gamma, Ray};
+use glam::{Affine3A, Vec3};
+
+/// The assignment's transformed unit sphere: `to_world` maps the unit sphere
+/// at the origin onto the shape (an ellipsoid under non-uniform scale). A ray
+/// is carried into object space, met there by the unit sphere, and the hit's
+/// normal is carried back by the inverse transpose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ellipsoid {
+    pub to_world: Affine3A,
+    to_object: Affine3A,
+}
+
+impl Ellipsoid {
+    /// `None` when the transform is singular (it would flatten the sphere).
+    pub fn new(to_world: Affine3A) -> Option<Self> {
+        let det = to_world.matrix3.determinant();
+        if !(det.abs() > 0.0) || !to_world.is_finite() {
+            return None;
+        }
+        let to_object = to_world.inverse();
+        to_object.is_finite().then_some(Ellipsoid { to_world, to_object })
+    }
+
+    /// The ray in object space with a unit direction, and the factor that
+    /// turns an object-space distance back into the world ray's parameter.
+    #[inline]
+    fn object_ray(&self, ray: &Ray) -> Option<(Ray, f32)> {
+        let d = self.to_object.transform_vector3(ray.dir);
+        let len = d.length();
+        if !(len > 0.0) || !len.is_finite() {
+            return None;
+        }
+        Some((Ray::new(self.to_object.transform_point3(ray.origin), d / len), len))
+    }
+
+    #[inline]
+    pub fn distance(&self, ray: &Ray, t_max: f32, departed: Option<bool>) -> Option<f32> {
+        let (local, len) = self.object_ray(ray)?;
+        let unit = Sphere { center: Vec3::ZERO, radius: 1.0 };
+        // The affine map keeps a line's parameter; only the unit-length
+        // normalisation in object space rescales it.
+        unit.distance(&local, t_max * len, departed).map(|t| t / len)
+    }
+
+    pub fn record(&self, ray: &Ray, t: f32) -> ShapeHit {
+        let (local_ray, len) = self.object_ray(ray).unwrap_or((*ray, 1.0));
+        let unit = Sphere { center: Vec3::ZERO, radius: 1.0 }.record(&local_ray, t * len);
+        let local = unit.point;
+        let point = self.to_world.transform_point3(local);
+        let m = self.to_world.matrix3;
+        let abs_m = glam::Mat3A::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
+        // The object point's error carried through the matrix, plus the
+        // rounding of the matrix product and the translation.
+        let p_err = Vec3::from(abs_m * glam::Vec3A::from(unit.p_err + gamma(4) * local.abs()))
+            + gamma(4)
+                * (Vec3::from(abs_m * glam::Vec3A::from(local.abs())) + Vec3::from(self.to_world.translation.abs()));
+        let normal = (self.to_object.matrix3.transpose() * glam::Vec3A::from(local)).normalize();
+        ShapeHit { t, point, p_err, normal: Vec3::from(normal) }
+    }
+
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        // Extent along axis i of the image of the unit sphere: |row i of M|.
+        let m = self.to_world.matrix3.transpose();
+        let e = Vec3::new(m.x_axis.length(), m.y_axis.length(), m.z_axis.length());
+        let c = Vec3::from(self.to_world.translation);
+        (c - e, c + e)
+    }
+}
