@@ -1,166 +1,24 @@
-//! The scene file: TOML read with serde, checked field by field, turned into
-//! [`SceneParts`]. The format's reference is notes/scene-format.md; the
-//! built-in room is `scenes/tncg15.toml`.
-//!
-//! Every value is read with its byte span, so a mistake is reported as
-//! `file:line:column: field: what is wrong`, whether serde found it (a type,
-//! an unknown or missing field) or the checks here (a negative radius, a
-//! material that does not exist, an OBJ file that cannot be read).
+//! A scene file's structure checked and turned into [`SceneParts`]: every
+//! value in range, every name defined, every field one its type uses.
 
-use super::mesh::load_obj;
-use super::{tncg15_room, LightSpec, Prim, SceneParts};
+use super::defs::*;
+use super::locate::Source;
+use super::{SceneError, SceneFile};
 use crate::camera::Camera;
 use crate::light::Emitting;
 use crate::material::{Material, Phong};
 use crate::math::Color;
+use crate::scene::mesh::load_obj;
+use crate::scene::{tncg15_room, LightSpec, Prim, SceneParts};
 use crate::shape::{tetrahedron, Disk, Ellipsoid, Shape, Sphere, Triangle};
 use glam::{Affine3A, Vec3};
-use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::ops::Range;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use toml::Spanned;
 
-/// A mistake in a scene file, located.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{}:{line}:{column}: {field}: {message}", path.display())]
-pub struct SceneError {
-    pub path: PathBuf,
-    pub line: usize,
-    pub column: usize,
-    /// Where in the scene's structure, e.g. `shapes[2].radius`.
-    pub field: String,
-    pub message: String,
-}
-
-/// A scene read from a file, with what only the Whitted program uses.
-#[derive(Debug, Clone)]
-pub struct SceneFile {
-    pub parts: SceneParts,
-    /// The n of the n x n jittered samples per pixel.
-    pub rays_per_pixel_edge: u32,
-    /// Whitted-only features that a physically based renderer cannot
-    /// honour (ambient light, a falloff other than 1/d^2, a Phong material
-    /// that creates energy), located.
-    pub not_physical: Vec<SceneError>,
-}
-
-type V3 = [f32; 3];
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct FileDef {
-    camera: Spanned<CameraDef>,
-    ambient: Option<Spanned<V3>>,
-    #[serde(default)]
-    materials: BTreeMap<String, Spanned<MaterialDef>>,
-    #[serde(default)]
-    shapes: Vec<Spanned<ShapeDef>>,
-    #[serde(default)]
-    lights: Vec<Spanned<LightDef>>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CameraDef {
-    eye: Spanned<V3>,
-    lower_left: Option<Spanned<V3>>,
-    lower_right: Option<Spanned<V3>>,
-    upper_left: Option<Spanned<V3>>,
-    upper_right: Option<Spanned<V3>>,
-    target: Option<Spanned<V3>>,
-    up: Option<Spanned<V3>>,
-    vfov: Option<Spanned<f32>>,
-    width: Spanned<i64>,
-    height: Spanned<i64>,
-    rays_per_pixel_edge: Option<Spanned<i64>>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct MaterialDef {
-    #[serde(rename = "type")]
-    kind: Spanned<String>,
-    rho: Option<Spanned<V3>>,
-    reflectance: Option<Spanned<V3>>,
-    ior: Option<Spanned<f32>>,
-    absorption: Option<Spanned<V3>>,
-    color: Option<Spanned<V3>>,
-    m_a: Option<Spanned<f32>>,
-    m_l: Option<Spanned<f32>>,
-    m_s: Option<Spanned<f32>>,
-    m_sm: Option<Spanned<f32>>,
-    m_sp: Option<Spanned<f32>>,
-    m_r: Option<Spanned<f32>>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ShapeDef {
-    #[serde(rename = "type")]
-    kind: Spanned<String>,
-    material: Option<Spanned<String>>,
-    emission: Option<Spanned<V3>>,
-    vertices: Option<Spanned<Vec<V3>>>,
-    center: Option<Spanned<V3>>,
-    radius: Option<Spanned<f32>>,
-    normal: Option<Spanned<V3>>,
-    file: Option<Spanned<String>>,
-    transform: Option<Vec<Spanned<StepDef>>>,
-    floor: Option<Spanned<String>>,
-    ceiling: Option<Spanned<String>>,
-    walls: Option<Spanned<Vec<Spanned<String>>>>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct StepDef {
-    translate: Option<Spanned<V3>>,
-    rotate: Option<Spanned<RotateDef>>,
-    scale: Option<Spanned<V3>>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RotateDef {
-    axis: Spanned<V3>,
-    degrees: Spanned<f32>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct LightDef {
-    #[serde(rename = "type")]
-    kind: Spanned<String>,
-    center: Option<Spanned<V3>>,
-    normal: Option<Spanned<V3>>,
-    radius: Option<Spanned<f32>>,
-    radiance: Option<Spanned<V3>>,
-    position: Option<Spanned<V3>>,
-    direction: Option<Spanned<V3>>,
-    color: Option<Spanned<V3>>,
-    falloff: Option<Spanned<f32>>,
-    dead_distance: Option<Spanned<f32>>,
-}
-
-/// Reads and checks a scene file. Relative OBJ paths are relative to the
-/// scene file's folder.
-pub fn load(path: &Path) -> Result<SceneFile, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
-        path: path.to_path_buf(),
-        line: 0,
-        column: 0,
-        field: "(file)".into(),
-        message: format!("cannot read the scene file: {e}"),
-    })?;
-    parse(&text, path)
-}
-
-/// Parses scene text as if read from `path` (used for messages and to find
-/// OBJ files next to it).
-pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
-    let src = Source { path, text };
-    let def: FileDef = toml::from_str(text).map_err(|e| src.toml_error(&e))?;
+/// Builds the scene from its checked structure.
+pub fn build(src: Source, def: FileDef) -> Result<SceneFile, SceneError> {
     Builder {
         src,
         materials: Vec::new(),
@@ -170,60 +28,6 @@ pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
         not_physical: Vec::new(),
     }
     .build(def)
-}
-
-/// The text being read, for turning spans into lines and columns.
-struct Source<'a> {
-    path: &'a Path,
-    text: &'a str,
-}
-
-impl Source<'_> {
-    fn error(&self, span: Range<usize>, field: impl Into<String>, message: impl Into<String>) -> SceneError {
-        let start = span.start.min(self.text.len());
-        let before = &self.text[..start];
-        let line = before.matches('\n').count() + 1;
-        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-        SceneError { path: self.path.to_path_buf(), line, column, field: field.into(), message: message.into() }
-    }
-
-    /// serde's and the TOML parser's errors, with the field found from the
-    /// text: the table header in effect and the key on the error's line.
-    fn toml_error(&self, e: &toml::de::Error) -> SceneError {
-        let span = e.span().unwrap_or(0..0);
-        let field = self.field_at(span.start);
-        self.error(span, field, e.message().trim().to_string())
-    }
-
-    fn field_at(&self, offset: usize) -> String {
-        let offset = offset.min(self.text.len());
-        let line_start = self.text[..offset].rfind('\n').map_or(0, |i| i + 1);
-        let mut table = String::new();
-        let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-        for line in self.text[..line_start].lines() {
-            let t = line.trim();
-            if let Some(name) = t.strip_prefix("[[").and_then(|r| r.split("]]").next()) {
-                let name = name.trim().to_string();
-                let n = counts.entry(name.clone()).or_insert(0);
-                table = format!("{name}[{n}]");
-                *n += 1;
-            } else if let Some(name) = t.strip_prefix('[').and_then(|r| r.split(']').next()) {
-                table = name.trim().to_string();
-            }
-        }
-        // The key on the error's own line, if the line is `key = value`.
-        let line = self.text[line_start..].lines().next().unwrap_or("");
-        let key = line
-            .split_once('=')
-            .map(|(k, _)| k.trim())
-            .filter(|k| !k.is_empty() && k.chars().all(|c| c.is_alphanumeric() || c == '_' || c == '.' || c == '"'));
-        match (table.is_empty(), key) {
-            (true, Some(k)) => k.to_string(),
-            (false, Some(k)) => format!("{table}.{k}"),
-            (false, None) => table,
-            (true, None) => "(top level)".to_string(),
-        }
-    }
 }
 
 struct Builder<'a> {

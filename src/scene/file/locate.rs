@@ -1,0 +1,87 @@
+//! Where in the file a mistake is: byte spans turned into line and column,
+//! and the field named by its path in the scene's structure.
+
+use super::defs::FileDef;
+use super::SceneError;
+use std::ops::Range;
+use std::path::Path;
+
+/// The text being read, for turning spans into lines and columns.
+#[derive(Clone, Copy)]
+pub struct Source<'a> {
+    pub path: &'a Path,
+    pub text: &'a str,
+}
+
+impl Source<'_> {
+    pub fn error(&self, span: Range<usize>, field: impl Into<String>, message: impl Into<String>) -> SceneError {
+        let start = span.start.min(self.text.len());
+        let before = &self.text[..start];
+        let line = before.matches('\n').count() + 1;
+        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        SceneError { path: self.path.to_path_buf(), line, column, field: field.into(), message: message.into() }
+    }
+
+    /// The file's structure, or its first mistake: a syntax error from the
+    /// TOML parser, or a type, an unknown or a missing field from serde,
+    /// whose path in the structure names the field (serde_path_to_error).
+    pub fn deserialize(&self) -> Result<FileDef, SceneError> {
+        let de = toml::Deserializer::parse(self.text).map_err(|e| self.syntax_error(&e))?;
+        serde_path_to_error::deserialize(de).map_err(|e| {
+            let field = field_path(e.path());
+            let inner = e.into_inner();
+            self.error(inner.span().unwrap_or(0..0), field, inner.message().trim().to_string())
+        })
+    }
+
+    /// A syntax error, named by the table it is in: the header on its own
+    /// line (a duplicated `[camera]`), else the last header before it.
+    fn syntax_error(&self, e: &toml::de::Error) -> SceneError {
+        let span = e.span().unwrap_or(0..0);
+        self.error(span.clone(), self.table_at(span.start), e.message().trim().to_string())
+    }
+
+    fn table_at(&self, offset: usize) -> String {
+        let offset = offset.min(self.text.len());
+        let line_end = self.text[offset..].find('\n').map_or(self.text.len(), |i| offset + i);
+        let mut table = "(top level)".to_string();
+        let mut counts = std::collections::BTreeMap::<String, usize>::new();
+        for line in self.text[..line_end].lines() {
+            let t = line.trim();
+            if let Some(name) = t.strip_prefix("[[").and_then(|r| r.split("]]").next()) {
+                let name = name.trim().to_string();
+                let n = counts.entry(name.clone()).or_insert(0);
+                table = format!("{name}[{n}]");
+                *n += 1;
+            } else if let Some(name) = t.strip_prefix('[').and_then(|r| r.split(']').next()) {
+                table = name.trim().to_string();
+            }
+        }
+        table
+    }
+}
+
+/// A path in the structure as the scene format names it, `shapes[0].radius`:
+/// the wrapper that carries each value's span is not a field of the format.
+fn field_path(path: &serde_path_to_error::Path) -> String {
+    use serde_path_to_error::Segment;
+    let mut out = String::new();
+    for segment in path.iter() {
+        match segment {
+            Segment::Seq { index } => out += &format!("[{index}]"),
+            Segment::Map { key } | Segment::Enum { variant: key } if key.starts_with("$__serde_spanned") => {}
+            Segment::Map { key } | Segment::Enum { variant: key } => {
+                if !out.is_empty() {
+                    out.push('.');
+                }
+                out += key;
+            }
+            Segment::Unknown => {}
+        }
+    }
+    if out.is_empty() {
+        "(top level)".to_string()
+    } else {
+        out
+    }
+}

@@ -1,0 +1,61 @@
+//! The scene file: TOML read with serde ([`defs`]), checked field by field
+//! and turned into [`SceneParts`] ([`build`]). The format's reference is
+//! notes/scene-format.md; the built-in room is `scenes/tncg15.toml`.
+//!
+//! Every value is read with its byte span, so a mistake is reported as
+//! `file:line:column: field: what is wrong` ([`locate`]), whether the TOML
+//! parser found it (a syntax error), serde (a type, an unknown or missing
+//! field) or the checks of [`build`] (a negative radius, a material that
+//! does not exist, an OBJ file that cannot be read).
+
+mod build;
+mod defs;
+mod locate;
+
+use super::SceneParts;
+use locate::Source;
+use std::path::{Path, PathBuf};
+
+/// A mistake in a scene file, located.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{}:{line}:{column}: {field}: {message}", path.display())]
+pub struct SceneError {
+    pub path: PathBuf,
+    pub line: usize,
+    pub column: usize,
+    /// Where in the scene's structure, e.g. `shapes[2].radius`.
+    pub field: String,
+    pub message: String,
+}
+
+/// A scene read from a file, with what only the Whitted program uses.
+#[derive(Debug, Clone)]
+pub struct SceneFile {
+    pub parts: SceneParts,
+    /// The n of the n x n jittered samples per pixel.
+    pub rays_per_pixel_edge: u32,
+    /// Whitted-only features that a physically based renderer cannot
+    /// honour (ambient light, a falloff other than 1/d^2, a Phong material
+    /// that creates energy), located.
+    pub not_physical: Vec<SceneError>,
+}
+
+/// Reads and checks a scene file. Relative OBJ paths are relative to the
+/// scene file's folder.
+pub fn load(path: &Path) -> Result<SceneFile, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        path: path.to_path_buf(),
+        line: 0,
+        column: 0,
+        field: "(file)".into(),
+        message: format!("cannot read the scene file: {e}"),
+    })?;
+    parse(&text, path)
+}
+
+/// Parses scene text as if read from `path` (used for messages and to find
+/// OBJ files next to it).
+pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
+    let src = Source { path, text };
+    build::build(src, src.deserialize()?)
+}
