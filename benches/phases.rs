@@ -6,8 +6,9 @@ use photonmap::photon::irradiance_cache::IrradianceCache;
 use photonmap::photon::map::{PhotonMap, Scratch};
 use photonmap::photon::trace::{trace_pass, Pass};
 use photonmap::progress::Mode;
-use photonmap::render::{cache_stride, render, Settings, GLOBAL_GRID_CELL, GLOBAL_RADIUS_FRACTION};
+use photonmap::render::{render, GLOBAL_GRID_CELL};
 use photonmap::scene::{Eye, Scene};
+use photonmap::settings::{cache_stride, Settings, GLOBAL_RADIUS_FRACTION};
 use std::hint::black_box;
 
 fn photon_pass(c: &mut Criterion) {
@@ -130,7 +131,7 @@ fn skips(c: &mut Criterion) {
     // own: pixels small enough for the samples to land within reach (at
     // 160 x 160 they rarely do), one gather ray to keep it short.
     let room = Scene::tncg15(Eye::One);
-    for reuse in [photonmap::render::CAUSTIC_REUSE, 0.0] {
+    for reuse in [photonmap::settings::CAUSTIC_REUSE, 0.0] {
         let settings = Settings {
             photons: 100_000,
             caustic_photons: 200_000,

@@ -11,8 +11,9 @@
 use photonmap::metrics::{compare, Metrics};
 use photonmap::output::read_exr;
 use photonmap::progress::Mode;
-use photonmap::render::{render, render_progressive, Budget, Method, Settings};
+use photonmap::render::{render, render_progressive, Budget};
 use photonmap::scene::{Eye, Scene};
+use photonmap::settings::{Method, Settings};
 use plotters::prelude::*;
 use std::io::Write;
 use std::time::Instant;

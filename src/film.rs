@@ -11,7 +11,7 @@ pub struct Film {
 }
 
 /// How radiance becomes an 8-bit value (TNCG15 lecture 6).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum ToneMap {
     /// v * 255.99 / i_max, i_max the largest channel value in the image.
     #[default]

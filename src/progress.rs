@@ -1,6 +1,7 @@
 //! Progress for long phases: a bar on a terminal, a few plain lines
 //! otherwise (logs, CI), nothing with `--quiet`.
 
+use crate::render::{Budget, PassReport};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -57,6 +58,59 @@ impl Phase {
             if b > a {
                 eprintln!("{}: {}%", self.label, b * 25);
             }
+        }
+    }
+
+    pub fn finish(self) {
+        if let Some(bar) = self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+/// Progress of a progressive render: passes done, radii, time left.
+pub struct PassDisplay {
+    mode: Mode,
+    budget: Budget,
+    bar: Option<ProgressBar>,
+}
+
+impl PassDisplay {
+    pub fn new(mode: Mode, budget: Budget) -> Self {
+        let bar = (mode == Mode::Bar).then(|| {
+            let len = match budget {
+                Budget::Passes(n) => n as u64,
+                Budget::Seconds(s) => s.ceil() as u64,
+            };
+            let bar = ProgressBar::new(len);
+            if let Ok(style) = ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}") {
+                bar.set_style(style.progress_chars("=> "));
+            }
+            bar
+        });
+        PassDisplay { mode, budget, bar }
+    }
+
+    pub fn update(&self, r: &PassReport) {
+        let elapsed = r.elapsed.as_secs_f64();
+        let left = match self.budget {
+            Budget::Passes(n) => elapsed / r.passes as f64 * (n.saturating_sub(r.passes)) as f64,
+            Budget::Seconds(s) => (s - elapsed).max(0.0),
+        };
+        let msg = format!(
+            "pass {:>5}  k {} / radius cap {:.4} (caustic), k {} / {:.4} (global)  {:>7.1} s elapsed  {:>7.1} s left",
+            r.passes, r.k_caustic, r.r_caustic, r.k_global, r.r_global, elapsed, left
+        );
+        match (&self.bar, self.mode) {
+            (Some(bar), _) => {
+                bar.set_message(msg);
+                bar.set_position(match self.budget {
+                    Budget::Passes(_) => r.passes as u64,
+                    Budget::Seconds(_) => elapsed as u64,
+                });
+            }
+            (None, Mode::Plain) => eprintln!("{msg}"),
+            _ => {}
         }
     }
 

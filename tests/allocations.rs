@@ -7,8 +7,9 @@
 
 use photonmap::photon::trace::{trace_pass, Pass};
 use photonmap::progress::Mode;
-use photonmap::render::{render, Settings};
+use photonmap::render::render;
 use photonmap::scene::{Eye, Scene};
+use photonmap::settings::Settings;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -63,9 +64,9 @@ fn check_counts() {
         |size| Settings { photons: 20_000, caustic_photons: 20_000, width: size, height: size, ..Settings::default() };
     let ((_, small), a_small) = count(|| render(&scene, &settings(32), Mode::Quiet));
     let ((_, large), a_large) = count(|| render(&scene, &settings(64), Mode::Quiet));
-    let extra_rays = large.camera_rays - small.camera_rays;
+    let extra_rays = large.camera.rays - small.camera.rays;
     let per_ray = (a_large - a_small) as f64 / extra_rays as f64;
-    eprintln!("camera pass: {a_small} / {a_large} allocations for {} / {} rays", small.camera_rays, large.camera_rays);
+    eprintln!("camera pass: {a_small} / {a_large} allocations for {} / {} rays", small.camera.rays, large.camera.rays);
     assert!(per_ray < 1e-2, "camera pass: {per_ray:.5} allocations per ray");
     let per_row = (a_large - a_small) as f64 / 32.0;
     assert!(per_row < 3.0, "camera pass: {per_row:.1} allocations per extra row of pixels");

@@ -5,8 +5,9 @@
 mod common;
 use common::*;
 use photonmap::film::Film;
-use photonmap::render::{render_progressive, Budget, Method, Settings};
+use photonmap::render::{render_progressive, Budget};
 use photonmap::scene::{Eye, Scene};
+use photonmap::settings::{Method, Settings};
 
 fn on_threads(threads: usize, f: impl FnOnce() -> Film + Send) -> Film {
     rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(f)

@@ -9,8 +9,9 @@ use photonmap::material::Material;
 use photonmap::math::Color;
 use photonmap::photon::trace::{trace_pass, Pass};
 use photonmap::progress::Mode;
-use photonmap::render::{render, Method, Settings};
+use photonmap::render::render;
 use photonmap::scene::{tncg15_room, Eye, LightSpec, Scene, SceneParts};
+use photonmap::settings::{Method, Settings};
 use photonmap::shape::Shape;
 
 fn furnace(le: f32, rho: f32) -> Scene {

@@ -5,8 +5,9 @@ mod common;
 use common::*;
 use photonmap::metrics::compare;
 use photonmap::progress::Mode;
-use photonmap::render::{render, render_progressive, Budget, Method, Settings};
+use photonmap::render::{render, render_progressive, Budget};
 use photonmap::scene::{Eye, Scene};
+use photonmap::settings::{Method, Settings};
 
 fn progressive(passes: u32) -> photonmap::metrics::Metrics {
     let scene = Scene::tncg15(Eye::One);
@@ -19,7 +20,7 @@ fn progressive(passes: u32) -> photonmap::metrics::Metrics {
         assert!(r.film.pixels.iter().all(|c| c.is_finite()));
     });
     assert_eq!((stats.passes, seen), (passes, passes));
-    assert_eq!(stats.nonfinite, 0);
+    assert_eq!(stats.camera.nonfinite, 0);
     compare(&film, &reference("default_e1_200.exr")).unwrap()
 }
 
@@ -47,7 +48,7 @@ fn path_tracer_agrees_with_the_reference_within_noise() {
         .map(|seed| {
             let s = Settings { method: Method::Path, spp: 8, width: 200, height: 200, seed, ..Settings::default() };
             let (film, stats) = render(&scene, &s, Mode::Quiet);
-            assert_eq!(stats.nonfinite, 0);
+            assert_eq!(stats.camera.nonfinite, 0);
             let m = compare(&film, &reference).unwrap();
             (m.mean_x, m.caustic_mean_x)
         })

@@ -8,9 +8,10 @@ use photonmap::material::Material;
 use photonmap::math::{Color, Ray};
 use photonmap::metrics::compare;
 use photonmap::progress::Mode;
-use photonmap::render::{render, Settings};
+use photonmap::render::render;
 use photonmap::sampling::{next_2d, stream, Domain};
 use photonmap::scene::{Eye, LightSpec, Prim, Scene, SceneParts};
+use photonmap::settings::Settings;
 use photonmap::shape::{Shape, Sphere, Triangle};
 use proptest::prelude::*;
 
@@ -234,7 +235,7 @@ fn small(photons: u64) -> Settings {
 
 fn render_parts(parts: SceneParts, settings: &Settings) -> Film {
     let (film, stats) = render(&Scene::from_parts(parts), settings, Mode::Quiet);
-    assert_eq!(stats.nonfinite, 0, "first non-finite: {:?}", stats.first_nonfinite);
+    assert_eq!(stats.camera.nonfinite, 0, "first non-finite: {:?}", stats.camera.first_nonfinite());
     assert!(film.pixels.iter().all(|c| c.is_finite()));
     film
 }

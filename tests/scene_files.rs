@@ -4,9 +4,10 @@
 //! default scene's file is the built-in room; mangled files never panic.
 
 use photonmap::progress::Mode;
-use photonmap::render::{render, Settings};
+use photonmap::render::render;
 use photonmap::scene::file::{load, parse};
 use photonmap::scene::{Eye, Scene};
+use photonmap::settings::Settings;
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -234,7 +235,7 @@ fn photon_mapping_agrees_with_path_tracing_for_every_light_type() {
         let scene = Scene::from_parts(parts);
         let base = Settings { width: 40, height: 40, ..Settings::default() };
         let photon = Settings { photons: 200_000, caustic_photons: 200_000, spp: 16, ..base };
-        let path = Settings { method: photonmap::render::Method::Path, spp: 1024, ..base };
+        let path = Settings { method: photonmap::settings::Method::Path, spp: 1024, ..base };
         let (a, sa) = render(&scene, &photon, Mode::Quiet);
         let (b, _) = render(&scene, &path, Mode::Quiet);
         assert!(sa.global_stored > 0, "{name}: no photons stored");
@@ -255,7 +256,7 @@ fn trace_refuses_an_image_that_cannot_fit() {
     let scene = dir.join("huge.toml");
     std::fs::write(&scene, text).unwrap();
     let need = 65536u64 * 65536 * 16;
-    if photonmap::render::available_memory().is_none_or(|a| a >= need) {
+    if photonmap::memory::available_memory().is_none_or(|a| a >= need) {
         return; // a machine with 70 GB free would render it
     }
     let out = dir.join("huge.png");

@@ -8,8 +8,10 @@ use photonmap::metrics::compare;
 use photonmap::photon::map::{PhotonMap, Scratch};
 use photonmap::photon::trace::{trace_pass, Pass};
 use photonmap::progress::Mode;
-use photonmap::render::{render, Settings, Stats};
+use photonmap::render::render;
 use photonmap::scene::{Eye, LightSpec, Scene, SceneParts};
+use photonmap::settings::Settings;
+use photonmap::stats::Stats;
 
 fn settings(skip: bool) -> Settings {
     Settings { photons: 50_000, caustic_photons: 50_000, width: 64, height: 64, skip, ..Settings::default() }
@@ -102,10 +104,10 @@ fn lights_facing_away_get_no_shadow_rays() {
         let scene = Scene::from_parts(parts);
         let (on, s_on) = render(&scene, &settings(true), Mode::Quiet);
         let (off, s_off) = render(&scene, &settings(false), Mode::Quiet);
-        assert!(s_on.shadow_rays_skipped > 0 && s_off.shadow_rays_skipped == 0);
+        assert!(s_on.camera.shadow_rays_skipped > 0 && s_off.camera.shadow_rays_skipped == 0);
         // No ray was ever cast for a sample with cos_l <= 0; the skip saves
         // choosing the samples, and the rays cast stay the same in count.
-        assert!(s_on.camera_rays.abs_diff(s_off.camera_rays) < s_off.camera_rays / 50);
+        assert!(s_on.camera.rays.abs_diff(s_off.camera.rays) < s_off.camera.rays / 50);
         // Skipped samples draw no random numbers, so the images differ by noise only.
         same_within_noise(&scene, &on, &off, if flip { "light facing up" } else { "ceiling behind the light" });
     }
@@ -126,15 +128,15 @@ fn a_pixels_samples_share_their_caustic_estimate() {
     let (off, s_off) = render(&scene, &without, Mode::Quiet);
     eprintln!(
         "caustic estimates {} + {} reused, without reuse {}",
-        s_on.caustic_estimates, s_on.caustic_reused, s_off.caustic_estimates
+        s_on.camera.caustic_estimates, s_on.camera.caustic_reused, s_off.camera.caustic_estimates
     );
-    assert_eq!(s_off.caustic_reused, 0);
+    assert_eq!(s_off.camera.caustic_reused, 0);
     // Reusing draws no random numbers: every sample follows the same path
     // and asks for a caustic estimate at the same points.
-    assert_eq!(s_on.caustic_estimates + s_on.caustic_reused, s_off.caustic_estimates);
-    assert_eq!(s_on.camera_rays, s_off.camera_rays);
+    assert_eq!(s_on.camera.caustic_estimates + s_on.camera.caustic_reused, s_off.camera.caustic_estimates);
+    assert_eq!(s_on.camera.rays, s_off.camera.rays);
     // 37% at this size (50% at the default 800 x 800 and 1e6 photons).
-    assert!(4 * s_on.caustic_reused > s_off.caustic_estimates, "{s_on:?}");
+    assert!(4 * s_on.camera.caustic_reused > s_off.camera.caustic_estimates, "{s_on:?}");
     same_within_noise_of(&scene, &without, &on, &off, "caustic reuse");
     // Tighter than noise: an estimate moves by less than a pixel, on the
     // same surface (0.0015 of the seed-to-seed RMSE here; reusing across

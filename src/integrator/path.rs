@@ -30,7 +30,10 @@ pub struct PathIntegrator<'a> {
 }
 
 impl Integrator for PathIntegrator<'_> {
-    fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context) -> Color {
+    type Thread = ();
+    type Pixel = ();
+
+    fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context, _: &mut (), _: &mut ()) -> Color {
         let mut radiance = Color::ZERO;
         let mut throughput = Color::ONE;
         let (mut ray, mut departure) = (ray, None);
@@ -39,7 +42,7 @@ impl Integrator for PathIntegrator<'_> {
         // Whether every vertex so far was specular (the path is E S* so far).
         let mut specular_chain = true;
         for depth in 0..MAX_DEPTH {
-            ctx.tally.rays += 1;
+            ctx.counters.rays += 1;
             let Some(hit) = self.scene.intersect(&ray, departure) else { break };
             throughput *= self.scene.transmittance(departure, hit.t);
             let material = *self.scene.material(hit.prim);

@@ -16,11 +16,11 @@
 //! Gather rays that reach a light (directly or through mirrors and glass)
 //! add nothing: those paths belong to the first two rows.
 
-use super::{direct_light, glass_branches, CausticMemo, Context, Integrator, Part, PendingRead};
+use super::{direct_light, glass_branches, Context, Integrator, Part};
 use crate::material::{Material, Phong};
 use crate::math::{max_component, Color, Frame, Ray};
-use crate::photon::irradiance_cache::IrradianceCache;
-use crate::photon::map::PhotonMap;
+use crate::photon::irradiance_cache::{CellRange, IrradianceCache};
+use crate::photon::map::{ConeEstimate, PhotonMap, Scratch};
 use crate::sampling::{cosine_hemisphere, next_2d, stratified_2d};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;
@@ -63,6 +63,56 @@ pub struct PhotonEstimator {
     /// A pixel's later samples reuse its last caustic estimate within this
     /// fraction of its radius, on the same surface (0: never).
     pub caustic_reuse: f32,
+    /// Leave the irradiance cache's reads for the end of the pixel's
+    /// samples ([`PendingRead`]); off: each read is made at once (the plain
+    /// version, which it must equal to rounding).
+    pub defer_reads: bool,
+}
+
+/// A read of precomputed irradiance that a camera sample leaves for later:
+/// the camera pass resolves a pixel's reads together, so that their cache
+/// misses overlap instead of following one another (final gathering's
+/// reads land anywhere in the scene; ~5% off the camera pass,
+/// notes/performance.md).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PendingRead {
+    pub point: glam::Vec3,
+    pub normal: glam::Vec3,
+    /// What the irradiance there is multiplied by on its way to the camera.
+    pub weight: Color,
+    pub cell: CellRange,
+}
+
+/// What a thread keeps between camera rays: scratch space for the map's
+/// searches and the reads left for later.
+#[derive(Default)]
+pub struct PhotonThread {
+    scratch: Scratch,
+    pending: Vec<PendingRead>,
+}
+
+/// What a pixel's samples share: its last caustic estimate, where it was
+/// made, on what surface, and how far from there it may stand in for a new
+/// one.
+#[derive(Default)]
+pub struct PhotonPixel {
+    caustic: Option<CausticMemo>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct CausticMemo {
+    point: glam::Vec3,
+    normal: glam::Vec3,
+    reach2: f32,
+    estimate: ConeEstimate,
+}
+
+/// A camera sample as the estimator sees it: the common context and this
+/// integrator's own thread and pixel state.
+struct Shade<'s, 'r> {
+    ctx: &'s mut Context<'r>,
+    thread: &'s mut PhotonThread,
+    pixel: &'s mut PhotonPixel,
 }
 
 pub struct PhotonIntegrator<'a> {
@@ -73,25 +123,32 @@ pub struct PhotonIntegrator<'a> {
 }
 
 impl Integrator for PhotonIntegrator<'_> {
-    fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context) -> Color {
-        self.trace(ray, None, 0, part, Color::ONE, ctx)
+    type Thread = PhotonThread;
+    type Pixel = PhotonPixel;
+
+    fn radiance(
+        &self,
+        ray: Ray,
+        part: Part,
+        ctx: &mut Context,
+        thread: &mut PhotonThread,
+        pixel: &mut PhotonPixel,
+    ) -> Color {
+        self.trace(ray, None, 0, part, Color::ONE, &mut Shade { ctx, thread, pixel })
     }
 
     /// Finds every read's cell first (each cell's slot was fetched when its
     /// gather ray hit, and this starts fetching the points), then reads.
-    fn resolve(&self, ctx: &mut Context) -> Color {
-        let Some(pending) = ctx.pending.take() else {
-            return Color::ZERO;
-        };
+    fn finish(&self, ctx: &mut Context, thread: &mut PhotonThread, _: &mut PhotonPixel) -> Color {
+        let PhotonThread { scratch, pending } = thread;
         for p in pending.iter_mut() {
             p.cell = self.cache.locate(p.point);
         }
         let mut sum = Color::ZERO;
         for p in pending.iter() {
-            sum += p.weight * self.cache.lookup_in(p.point, p.normal, p.cell, ctx.scratch);
+            sum += p.weight * self.cache.lookup_in(p.point, p.normal, p.cell, scratch);
         }
         pending.clear();
-        ctx.pending = Some(pending);
         ctx.checked(sum, "indirect")
     }
 }
@@ -100,16 +157,8 @@ impl Integrator for PhotonIntegrator<'_> {
 /// is multiplied by on its way to the camera: the weight of a read left
 /// for later (see [`PendingRead`]).
 impl PhotonIntegrator<'_> {
-    fn trace(
-        &self,
-        ray: Ray,
-        departure: Option<Departure>,
-        depth: u32,
-        part: Part,
-        w: Color,
-        ctx: &mut Context,
-    ) -> Color {
-        ctx.tally.rays += 1;
+    fn trace(&self, ray: Ray, departure: Option<Departure>, depth: u32, part: Part, w: Color, sh: &mut Shade) -> Color {
+        sh.ctx.counters.rays += 1;
         let Some(hit) = self.scene.intersect(&ray, departure) else {
             return Color::ZERO;
         };
@@ -118,32 +167,32 @@ impl PhotonIntegrator<'_> {
         let radiance = match *self.scene.material(hit.prim) {
             Material::Emitter if part == Part::Reflected => Color::ZERO,
             Material::Emitter => self.scene.light_of(hit.prim).map_or(Color::ZERO, |l| l.radiance_towards(ray.dir)),
-            Material::Lambertian { rho } => self.surface(&hit, &ray, rho, None, depth, part, w, ctx),
-            Material::Phong(p) => self.surface(&hit, &ray, p.diffuse_rho(), Some(&p), depth, part, w, ctx),
-            Material::Mirror { reflectance } => self.mirror(&hit, &ray, reflectance, depth, part, w, ctx),
+            Material::Lambertian { rho } => self.surface(&hit, &ray, rho, None, depth, part, w, sh),
+            Material::Phong(p) => self.surface(&hit, &ray, p.diffuse_rho(), Some(&p), depth, part, w, sh),
+            Material::Mirror { reflectance } => self.mirror(&hit, &ray, reflectance, depth, part, w, sh),
             Material::Glass { ior, .. } => {
                 if depth >= MAX_SPECULAR_DEPTH {
                     return Color::ZERO;
                 }
                 let branches = glass_branches(&hit, &ray, ior);
-                let reflected = |s: &Self, w: Color, ctx: &mut Context| {
+                let reflected = |s: &Self, w: Color, sh: &mut Shade| {
                     let (next, dep) = hit.spawn(branches.reflected);
-                    s.trace(next, Some(dep), depth + 1, part, w, ctx)
+                    s.trace(next, Some(dep), depth + 1, part, w, sh)
                 };
                 match branches.refracted {
-                    None => reflected(self, w, ctx),
+                    None => reflected(self, w, sh),
                     Some((wt, radiance_scale)) => {
-                        let refracted = |s: &Self, w: Color, ctx: &mut Context| {
+                        let refracted = |s: &Self, w: Color, sh: &mut Shade| {
                             let (next, dep) = hit.spawn(wt);
-                            radiance_scale * s.trace(next, Some(dep), depth + 1, part, w * radiance_scale, ctx)
+                            radiance_scale * s.trace(next, Some(dep), depth + 1, part, w * radiance_scale, sh)
                         };
                         let r = branches.fresnel;
                         if depth < SPLIT_DEPTH {
-                            r * reflected(self, w * r, ctx) + (1.0 - r) * refracted(self, w * (1.0 - r), ctx)
-                        } else if ctx.rng.random::<f32>() < r {
-                            reflected(self, w, ctx)
+                            r * reflected(self, w * r, sh) + (1.0 - r) * refracted(self, w * (1.0 - r), sh)
+                        } else if sh.ctx.rng.random::<f32>() < r {
+                            reflected(self, w, sh)
                         } else {
-                            refracted(self, w, ctx)
+                            refracted(self, w, sh)
                         }
                     }
                 }
@@ -162,13 +211,13 @@ impl PhotonIntegrator<'_> {
         depth: u32,
         part: Part,
         w: Color,
-        ctx: &mut Context,
+        sh: &mut Shade,
     ) -> Color {
         if depth >= MAX_SPECULAR_DEPTH || max_component(reflectance) <= 0.0 {
             return Color::ZERO;
         }
         let (next, dep) = hit.spawn(hit.mirrored(ray.dir));
-        reflectance * self.trace(next, Some(dep), depth + 1, part, w * reflectance, ctx)
+        reflectance * self.trace(next, Some(dep), depth + 1, part, w * reflectance, sh)
     }
 
     /// A surface with a Lambertian lobe `rho` and, for the Phong material,
@@ -183,10 +232,10 @@ impl PhotonIntegrator<'_> {
         depth: u32,
         part: Part,
         w: Color,
-        ctx: &mut Context,
+        sh: &mut Shade,
     ) -> Color {
         let mirrored = match phong {
-            Some(p) => self.mirror(hit, ray, p.mirror_rho(), depth, part, w, ctx),
+            Some(p) => self.mirror(hit, ray, p.mirror_rho(), depth, part, w, sh),
             None => Color::ZERO,
         };
         // A glowing surface's own light (zero for all but area lights).
@@ -201,42 +250,42 @@ impl PhotonIntegrator<'_> {
         let n = hit.facing_normal(ray.dir);
         let to_viewer = -ray.dir;
         let brdf = |w: glam::Vec3| phong.map_or(rho / PI, |p| p.brdf(n, w, to_viewer));
-        let direct = direct_light(self.scene, hit, n, brdf, self.settings.shadow_rays, self.settings.skip, ctx);
+        let direct = direct_light(self.scene, hit, n, brdf, self.settings.shadow_rays, self.settings.skip, sh.ctx);
         let (mut caustic, mut indirect) = (Color::ZERO, Color::ZERO);
         if max_component(rho) > 0.0 {
-            caustic = self.caustic(hit, n, rho, ctx);
-            indirect = self.indirect(hit, n, rho, w, ctx);
+            caustic = self.caustic(hit, n, rho, sh);
+            indirect = self.indirect(hit, n, rho, w, sh);
         }
         if let Some(p) = phong.filter(|_| glossy) {
             // One gather ray from the glossy lobe: indirect light it reflects.
-            if let Some((dir, weight)) = p.sample_glossy(n, to_viewer, next_2d(ctx.rng)) {
+            if let Some((dir, weight)) = p.sample_glossy(n, to_viewer, next_2d(sh.ctx.rng)) {
                 let (next, dep) = hit.spawn(dir);
-                indirect += weight * self.gather(next, dep, w * weight, ctx);
+                indirect += weight * self.gather(next, dep, w * weight, sh);
             }
         }
         mirrored
-            + self.checked(direct, "direct", ctx)
-            + self.checked(caustic, "caustic", ctx)
-            + self.checked(indirect, "indirect", ctx)
+            + self.checked(direct, "direct", sh)
+            + self.checked(caustic, "caustic", sh)
+            + self.checked(indirect, "indirect", sh)
     }
 
     /// Light → specular+ → x: the caustic map.
-    fn caustic(&self, hit: &Hit, n: glam::Vec3, rho: Color, ctx: &mut Context) -> Color {
+    fn caustic(&self, hit: &Hit, n: glam::Vec3, rho: Color, sh: &mut Shade) -> Color {
         if self.caustic.is_empty() {
             return Color::ZERO;
         }
-        if let Some(m) = ctx.memo.caustic {
+        if let Some(m) = sh.pixel.caustic {
             if m.normal.dot(n) >= REUSE_NORMAL_COSINE && m.point.distance_squared(hit.point) <= m.reach2 {
-                ctx.tally.caustic_reused += 1;
+                sh.ctx.counters.caustic_reused += 1;
                 return m.estimate.radiance(rho);
             }
         }
         let s = &self.settings;
-        let estimate = self.caustic.cone_estimate(hit.point, n, s.k_caustic, s.r_caustic, ctx.scratch);
-        ctx.tally.caustic_estimates += 1;
+        let estimate = self.caustic.cone_estimate(hit.point, n, s.k_caustic, s.r_caustic, &mut sh.thread.scratch);
+        sh.ctx.counters.caustic_estimates += 1;
         if s.caustic_reuse > 0.0 {
             let reach2 = s.caustic_reuse * s.caustic_reuse * estimate.r2;
-            ctx.memo.caustic = Some(CausticMemo { point: hit.point, normal: n, reach2, estimate });
+            sh.pixel.caustic = Some(CausticMemo { point: hit.point, normal: n, reach2, estimate });
         }
         estimate.radiance(rho)
     }
@@ -244,12 +293,10 @@ impl PhotonIntegrator<'_> {
     /// Light → … diffuse y → (specular*) → x: final gathering.
     ///
     /// Each read of the cache is a cache miss (gather hits land anywhere in
-    /// the scene): where the camera pass lets it, the reads are left in
-    /// `ctx.pending` and made at the end of the pixel's samples, all of
-    /// their fetches under way at once (~5% off the camera pass, stop 16);
-    /// else made here. The random numbers are drawn in the same order
-    /// either way.
-    fn indirect(&self, hit: &Hit, n: glam::Vec3, rho: Color, w: Color, ctx: &mut Context) -> Color {
+    /// the scene): the reads are left for the end of the pixel's samples
+    /// ([`PendingRead`]), all of their fetches under way at once. The
+    /// random numbers are drawn in the same order either way.
+    fn indirect(&self, hit: &Hit, n: glam::Vec3, rho: Color, w: Color, sh: &mut Shade) -> Color {
         let count = self.settings.gather_rays;
         if count == 0 || self.cache.is_empty() {
             return Color::ZERO;
@@ -259,10 +306,10 @@ impl PhotonIntegrator<'_> {
         let w = w * rho / count as f32;
         let mut sum = Color::ZERO;
         for g in 0..count {
-            let dir = frame.to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(ctx.rng)))).normalize();
+            let dir = frame.to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(sh.ctx.rng)))).normalize();
             let (ray, dep) = hit.spawn(dir);
-            let h = self.gather_hit(ray, dep, ctx);
-            sum += self.read(&h, w, ctx);
+            let h = self.gather_hit(ray, dep, sh);
+            sum += self.read(&h, w, sh);
         }
         rho * sum / count as f32
     }
@@ -270,35 +317,34 @@ impl PhotonIntegrator<'_> {
     /// Radiance arriving along a gather ray that was reflected by a diffuse
     /// surface at least once before: followed through mirrors and glass to
     /// the first diffuse y, where the global map's irradiance is read.
-    fn gather(&self, ray: Ray, dep: Departure, w: Color, ctx: &mut Context) -> Color {
+    fn gather(&self, ray: Ray, dep: Departure, w: Color, sh: &mut Shade) -> Color {
         if self.cache.is_empty() {
             return Color::ZERO;
         }
-        let h = self.gather_hit(ray, dep, ctx);
-        self.read(&h, w, ctx)
+        let h = self.gather_hit(ray, dep, sh);
+        self.read(&h, w, sh)
     }
 
     /// The irradiance read at gather hit `h` times its weight; or, where
-    /// `ctx.pending` takes reads, zero, the read left there with weight `w`
+    /// reads are deferred, zero, the read left for later with weight `w`
     /// times the hit's (`w`: what the radiance leaving along the gather ray
     /// is multiplied by on its way to the camera) and its cell's slot
     /// being fetched.
-    fn read(&self, h: &GatherHit, w: Color, ctx: &mut Context) -> Color {
+    fn read(&self, h: &GatherHit, w: Color, sh: &mut Shade) -> Color {
         if h.weight == Color::ZERO {
             return Color::ZERO;
         }
-        match ctx.pending.as_deref_mut() {
-            Some(pending) => {
-                self.cache.prefetch_cell(h.point);
-                pending.push(PendingRead {
-                    point: h.point,
-                    normal: h.normal,
-                    weight: w * h.weight,
-                    ..Default::default()
-                });
-                Color::ZERO
-            }
-            None => h.weight * self.cache.lookup(h.point, h.normal, ctx.scratch),
+        if self.settings.defer_reads {
+            self.cache.prefetch_cell(h.point);
+            sh.thread.pending.push(PendingRead {
+                point: h.point,
+                normal: h.normal,
+                weight: w * h.weight,
+                ..Default::default()
+            });
+            Color::ZERO
+        } else {
+            h.weight * self.cache.lookup(h.point, h.normal, &mut sh.thread.scratch)
         }
     }
 
@@ -306,10 +352,10 @@ impl PhotonIntegrator<'_> {
     /// first diffuse surface y, and the weight (path throughput times
     /// rho_y / pi) that y's irradiance takes; a zero weight where it meets
     /// none.
-    fn gather_hit(&self, mut ray: Ray, mut dep: Departure, ctx: &mut Context) -> GatherHit {
+    fn gather_hit(&self, mut ray: Ray, mut dep: Departure, sh: &mut Shade) -> GatherHit {
         let mut weight = Color::ONE;
         for _ in 0..MAX_SPECULAR_DEPTH {
-            ctx.tally.rays += 1;
+            sh.ctx.counters.rays += 1;
             let Some(y) = self.scene.intersect(&ray, Some(dep)) else {
                 break;
             };
@@ -332,7 +378,7 @@ impl PhotonIntegrator<'_> {
                 Material::Glass { ior, .. } => {
                     let b = glass_branches(&y, &ray, ior);
                     match b.refracted {
-                        Some((wt, scale)) if ctx.rng.random::<f32>() >= b.fresnel => {
+                        Some((wt, scale)) if sh.ctx.rng.random::<f32>() >= b.fresnel => {
                             weight *= scale;
                             wt
                         }
@@ -346,7 +392,7 @@ impl PhotonIntegrator<'_> {
         GatherHit::default()
     }
 
-    fn checked(&self, c: Color, estimator: &'static str, ctx: &mut Context) -> Color {
-        ctx.checked(c, estimator)
+    fn checked(&self, c: Color, estimator: &'static str, sh: &mut Shade) -> Color {
+        sh.ctx.checked(c, estimator)
     }
 }

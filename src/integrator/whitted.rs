@@ -15,13 +15,14 @@
 use crate::film::Film;
 use crate::material::{Material, Phong};
 use crate::math::{max_component, Color, Ray};
-use crate::sampling::{next_2d, stratified_2d, stream, Domain, Rng};
+use crate::progress::Mode;
+use crate::render::{camera_pass, CameraPass};
+use crate::sampling::{next_2d, stratified_2d, Rng};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;
-use rayon::prelude::*;
 use std::f32::consts::PI;
 
-use super::glass_branches;
+use super::{glass_branches, Context, Integrator, Part};
 
 /// Shadow-ray samples per area light per shaded point (the course's lights
 /// are points; area lights get a soft shadow from this many samples).
@@ -120,29 +121,30 @@ impl Whitted<'_> {
         c
     }
 
-    /// Renders the scene's camera at `width` x `height`, each pixel the mean
-    /// of an n x n grid of jittered samples (n = `rays_per_pixel_edge`).
-    /// Every pixel has its own random stream: the image does not depend on
-    /// the number of threads.
+    /// Renders the scene's camera at `width` x `height` on the shared
+    /// camera pass, each pixel the mean of an n x n grid of jittered
+    /// samples (n = `rays_per_pixel_edge`).
     pub fn render(&self, width: u32, height: u32, rays_per_pixel_edge: u32, seed: u64) -> Film {
-        let camera = self.scene.camera.with_resolution(width, height);
-        let spp = rays_per_pixel_edge * rays_per_pixel_edge;
-        let pixels: Vec<Color> = (0..height)
-            .into_par_iter()
-            .flat_map_iter(|row| {
-                (0..width).map(move |col| {
-                    let pixel = row as u64 * width as u64 + col as u64;
-                    let mut rng = stream(seed, Domain::Camera, pixel);
-                    let mut sum = Color::ZERO;
-                    for s in 0..spp {
-                        let ray = camera.ray(col, row, stratified_2d(s, spp, next_2d(&mut rng)));
-                        sum += self.trace_ray(&ray, None, 0, &mut rng);
-                    }
-                    debug_assert!(sum.is_finite(), "Whitted sample at pixel ({col}, {row}) is {sum}");
-                    sum / spp as f32
-                })
-            })
-            .collect();
-        Film { width, height, pixels }
+        let pass = CameraPass {
+            camera: self.scene.camera.with_resolution(width, height),
+            spp: rays_per_pixel_edge * rays_per_pixel_edge,
+            edge_spp: 0,
+            seed,
+            pass: 0,
+        };
+        camera_pass(&pass, self, Mode::Quiet, &mut None).film
+    }
+}
+
+impl Integrator for Whitted<'_> {
+    type Thread = ();
+    type Pixel = ();
+
+    /// The course's `traceRay` (it has no separate emitted part: the camera
+    /// pass asks it for everything).
+    fn radiance(&self, ray: Ray, _: Part, ctx: &mut Context, _: &mut (), _: &mut ()) -> Color {
+        ctx.counters.rays += 1;
+        let c = self.trace_ray(&ray, None, 0, ctx.rng);
+        ctx.checked(c, "whitted")
     }
 }

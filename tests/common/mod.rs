@@ -5,8 +5,9 @@ use photonmap::film::Film;
 use photonmap::metrics::{compare, Metrics};
 use photonmap::output::{read_exr, write};
 use photonmap::progress::Mode;
-use photonmap::render::{render, Settings};
+use photonmap::render::render;
 use photonmap::scene::Scene;
+use photonmap::settings::Settings;
 use std::path::{Path, PathBuf};
 
 pub fn data(name: &str) -> PathBuf {
@@ -32,7 +33,7 @@ pub fn ci_settings(size: u32) -> Settings {
 
 pub fn render_quiet(scene: &Scene, settings: &Settings) -> Film {
     let (film, stats) = render(scene, settings, Mode::Quiet);
-    assert_eq!(stats.nonfinite, 0, "non-finite samples: first at {:?}", stats.first_nonfinite);
+    assert_eq!(stats.camera.nonfinite, 0, "non-finite samples: first at {:?}", stats.camera.first_nonfinite());
     film
 }
 

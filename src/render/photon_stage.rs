@@ -1,0 +1,151 @@
+//! The photon stage of a pass: trace the global and caustic photons, build
+//! the caustic map and the global map's irradiance cache, and make the
+//! camera pass's estimator over them.
+
+use crate::integrator::photon::{PhotonEstimator, PhotonIntegrator};
+use crate::photon::irradiance_cache::IrradianceCache;
+use crate::photon::map::PhotonMap;
+use crate::photon::trace::{trace_pass, Pass};
+use crate::progress::{Mode, Phase};
+use crate::scene::Scene;
+use crate::settings::{cache_stride, Settings};
+use crate::stats::Stats;
+use std::time::Instant;
+
+/// The density-estimation settings of one photon-mapping pass: k nearest
+/// photons within a radius cap, for the global (irradiance) and caustic maps.
+#[derive(Clone, Copy, Debug)]
+pub struct Estimates {
+    pub k_global: usize,
+    pub k_caustic: usize,
+    pub r_global: f32,
+    pub r_caustic: f32,
+}
+
+impl Estimates {
+    /// Pass `i` (0-based; pass 0 is the classic render's settings): k and the
+    /// squared radius cap scaled by s_i = prod_{k=1}^{i} (k + alpha - 1) / k. Per pass the
+    /// variance grows as 1 / s_i and the bias shrinks as s_i, so the average
+    /// of n passes has variance ~ n^-alpha and bias ~ n^(alpha-1) (Knaus &
+    /// Zwicker 2011), while each estimate keeps adapting to the local density.
+    /// k stays at least 2 (the estimators use the k-1 photons inside the rim).
+    pub fn progressive(scene: &Scene, settings: &Settings, pass: u32) -> Self {
+        let s: f64 = (1..=pass).map(|k| (k as f64 + settings.alpha as f64 - 1.0) / k as f64).product();
+        let k = |k: usize| ((k as f64 * s).round() as usize).max(2);
+        Estimates {
+            k_global: k(settings.k_global),
+            k_caustic: k(settings.k_caustic),
+            r_global: settings.r_global(scene) * s.sqrt() as f32,
+            r_caustic: settings.r_caustic(scene) * s.sqrt() as f32,
+        }
+    }
+}
+
+/// The maps of one photon-mapping pass. The global map itself is dropped
+/// once its irradiance is cached: the camera pass reads only the cache.
+pub struct Maps {
+    pub caustic: PhotonMap,
+    pub cache: IrradianceCache,
+}
+
+/// Traces the photons of pass `pass` and builds its maps.
+pub fn photon_pass(
+    scene: &Scene,
+    settings: &Settings,
+    pass: u64,
+    est: Estimates,
+    progress: Mode,
+    stats: &mut Stats,
+) -> Maps {
+    let seed = pass_seed(settings.seed, pass);
+    let needs = scene.needs();
+    stats.skipped_global = settings.skip && !needs.global;
+    stats.skipped_caustic = settings.skip && !needs.caustics;
+    let settings = &Settings {
+        photons: if stats.skipped_global { 0 } else { settings.photons },
+        caustic_photons: if stats.skipped_caustic { 0 } else { settings.caustic_photons },
+        ..*settings
+    };
+    let t = Instant::now();
+    let phase = Phase::start(progress, "photon pass", settings.photons + settings.caustic_photons);
+    // Both passes at once: the threads that finish one pass's last blocks
+    // early take the other's instead of waiting.
+    let (global, caustic) = rayon::join(
+        || trace_pass(scene, Pass::Global, settings.photons, seed, &|n| phase.advance(n)),
+        || trace_pass(scene, Pass::Caustic, settings.caustic_photons, seed, &|n| phase.advance(n)),
+    );
+    phase.finish();
+    stats.photon_time += t.elapsed();
+    stats.global_emitted += global.emitted;
+    stats.caustic_emitted += caustic.emitted;
+    stats.caustic_aimed_hits += caustic.first_hit_specular;
+    stats.global_specular_hits += global.first_hit_specular;
+    stats.photon_rays += global.rays + caustic.rays;
+
+    let t = Instant::now();
+    // Caustic lookups run at every visible diffuse point and mostly near
+    // the radius cap: the grid serves them (and rejects empty regions).
+    // Global-map lookups run at photons (the irradiance cache), at radii
+    // far below the cap: a finer grid serves most of them. The two builds
+    // at once: each has serial stretches the other can fill.
+    let (global_map, caustic_map) = rayon::join(
+        || PhotonMap::build_for_photon_lookups(global.photons, est.r_global * GLOBAL_GRID_CELL),
+        || {
+            let map = PhotonMap::build_with_grid(caustic.photons, Some(est.r_caustic));
+            if settings.skip {
+                map
+            } else {
+                map.without_grid()
+            }
+        },
+    );
+    stats.tree_time += t.elapsed();
+    let t = Instant::now();
+    let stride = settings.cache_stride.unwrap_or_else(|| cache_stride(est.k_global));
+    let cache = IrradianceCache::build(&global_map, stride, est.k_global, est.r_global);
+    stats.cache_time += t.elapsed();
+    stats.global_stored = global_map.len();
+    stats.caustic_stored = caustic_map.len();
+    stats.cache_points = cache.len();
+    stats.map_bytes = global_map.memory_bytes() + caustic_map.memory_bytes();
+    Maps { caustic: caustic_map, cache }
+}
+
+/// The global map's grid cells, as a fraction of its radius cap: sized
+/// for the radius its estimates need (the k-th photon's distance, a few
+/// percent of the cap where photons are dense), not for the cap. The
+/// grid's cell budget widens them in a large scene, and where photons are
+/// so dense that searches would read too many the map goes without.
+pub const GLOBAL_GRID_CELL: f32 = 0.025;
+
+/// The seed of pass `pass`: pass 0 uses the seed itself, so a one-pass
+/// progressive render is the classic render's photon set.
+pub fn pass_seed(seed: u64, pass: u64) -> u64 {
+    if pass == 0 {
+        seed
+    } else {
+        crate::sampling::splitmix64(seed ^ pass.wrapping_mul(0xA076_1D64_78BD_642F))
+    }
+}
+
+pub fn photon_integrator<'a>(
+    scene: &'a Scene,
+    settings: &Settings,
+    maps: &'a Maps,
+    est: Estimates,
+) -> PhotonIntegrator<'a> {
+    PhotonIntegrator {
+        scene,
+        caustic: &maps.caustic,
+        cache: &maps.cache,
+        settings: PhotonEstimator {
+            k_caustic: est.k_caustic,
+            r_caustic: est.r_caustic,
+            gather_rays: settings.gather_rays,
+            shadow_rays: settings.shadow_rays,
+            skip: settings.skip,
+            caustic_reuse: settings.caustic_reuse,
+            defer_reads: true,
+        },
+    }
+}

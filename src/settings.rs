@@ -1,0 +1,114 @@
+//! Every setting that decides a render, with its default: the command
+//! lines take their defaults from here.
+
+use crate::scene::Scene;
+
+/// The estimator a render uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Method {
+    /// Photon mapping: direct light, caustic map, final gathering.
+    #[default]
+    Photon,
+    /// Path tracing with next-event estimation (unbiased, the reference).
+    Path,
+}
+
+/// Everything that decides the image besides the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct Settings {
+    pub method: Method,
+    /// Photons emitted for the global map.
+    pub photons: u64,
+    /// Photons emitted (aimed at mirrors and glass) for the caustic map.
+    pub caustic_photons: u64,
+    /// Jittered camera samples per pixel.
+    pub spp: u32,
+    pub seed: u64,
+    pub width: u32,
+    pub height: u32,
+    /// Nearest photons per global-map (irradiance) estimate.
+    pub k_global: usize,
+    /// Nearest photons per caustic estimate.
+    pub k_caustic: usize,
+    /// Search radius caps; `None`: a fraction of the scene's diagonal.
+    pub r_global: Option<f32>,
+    pub r_caustic: Option<f32>,
+    pub gather_rays: u32,
+    pub shadow_rays: u32,
+    /// Irradiance is precomputed at every n-th global photon; `None`: at
+    /// every (k_global / CACHE_POINTS_PER_DISK)-th ([`cache_stride`]).
+    pub cache_stride: Option<usize>,
+    /// A pixel's later samples reuse its last caustic estimate where they
+    /// land on the same surface within this fraction of that estimate's
+    /// radius (0: every sample makes its own).
+    pub caustic_reuse: f32,
+    /// Samples of the emitted part in pixels on the rim of a light's image.
+    pub edge_spp: u32,
+    /// Skip what the scene does not need (photon maps it cannot use, shadow
+    /// rays towards lights facing away); off only to check the skips.
+    pub skip: bool,
+    /// Progressive photon mapping's radius shrinkage (Knaus & Zwicker 2011):
+    /// pass i uses r_i^2 = r_1^2 * prod_{k<i} (k + alpha - 1) / k.
+    pub alpha: f32,
+}
+
+/// The defaults of every setting (the command lines show and use these).
+pub const DEFAULT: Settings = Settings {
+    method: Method::Photon,
+    photons: 1_000_000,
+    caustic_photons: 1_000_000,
+    spp: 4,
+    seed: 1,
+    width: 800,
+    height: 800,
+    k_global: 100,
+    k_caustic: 100,
+    r_global: None,
+    r_caustic: None,
+    gather_rays: 4,
+    shadow_rays: 2,
+    cache_stride: None,
+    caustic_reuse: CAUSTIC_REUSE,
+    edge_spp: 256,
+    skip: true,
+    alpha: 2.0 / 3.0,
+};
+
+impl Default for Settings {
+    fn default() -> Self {
+        DEFAULT
+    }
+}
+
+/// The default [`Settings::caustic_reuse`].
+pub const CAUSTIC_REUSE: f32 = 0.1;
+
+/// Default caps on the search radius as fractions of the scene diagonal: the
+/// k-nearest estimate sets the radius wherever photons are dense; the cap
+/// only bounds the blur where they are sparse.
+pub const GLOBAL_RADIUS_FRACTION: f32 = 0.05;
+pub const CAUSTIC_RADIUS_FRACTION: f32 = 0.01;
+
+impl Settings {
+    pub fn r_global(&self, scene: &Scene) -> f32 {
+        self.r_global.unwrap_or(GLOBAL_RADIUS_FRACTION * scene.diagonal())
+    }
+
+    pub fn r_caustic(&self, scene: &Scene) -> f32 {
+        self.r_caustic.unwrap_or(CAUSTIC_RADIUS_FRACTION * scene.diagonal())
+    }
+}
+
+/// Precomputed irradiance values per k-nearest estimate disk, by default.
+/// Gather rays read the nearest value, which lies, on average, towards where
+/// photons (and so the values) are denser: the sparser the values, the more
+/// that leans towards brighter neighbours. Measured (notes/performance.md):
+/// at 6 per disk the default's mean moves by 0.02%; at 1.6 per disk (stride
+/// 16 with the k = 25 of a 60th progressive pass) by +0.45%.
+pub const CACHE_POINTS_PER_DISK: usize = 6;
+
+/// The default stride: `CACHE_POINTS_PER_DISK` cached values per estimate
+/// disk of `k_global` photons (16 at the default k = 100).
+pub fn cache_stride(k_global: usize) -> usize {
+    (k_global / CACHE_POINTS_PER_DISK).max(1)
+}

@@ -1,0 +1,228 @@
+//! What a render did and what it cost: the counters each thread keeps while
+//! it shades ([`Counters`]), the render's totals and times ([`Stats`]), and
+//! the summary printed at the end ([`Summary`]). A new statistic is a field
+//! here and a line of the summary.
+
+use crate::settings::{Method, Settings};
+use std::path::PathBuf;
+use std::time::Duration;
+
+/// What a thread counted while it shaded; summed over threads by [`merge`](Counters::merge).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Counters {
+    /// Rays cast.
+    pub rays: u64,
+    /// Samples whose radiance came out non-finite (a bug at some
+    /// estimator; never written).
+    pub nonfinite: u64,
+    /// Shadow rays not cast: the light's back faced the point.
+    pub shadow_rays_skipped: u64,
+    /// Caustic estimates made, and those a pixel's earlier sample answered.
+    pub caustic_estimates: u64,
+    pub caustic_reused: u64,
+    /// First non-finite sample seen: (pixel index, estimator name).
+    first_nonfinite: Option<(u64, &'static str)>,
+}
+
+impl Counters {
+    pub fn merge(mut self, other: Counters) -> Counters {
+        self.rays += other.rays;
+        self.nonfinite += other.nonfinite;
+        self.shadow_rays_skipped += other.shadow_rays_skipped;
+        self.caustic_estimates += other.caustic_estimates;
+        self.caustic_reused += other.caustic_reused;
+        if let Some((pixel, estimator)) = other.first_nonfinite {
+            self.note_nonfinite(pixel, estimator);
+        }
+        self
+    }
+
+    /// Remembers the non-finite sample of the lowest pixel index, so the
+    /// report does not depend on the order threads finished in.
+    pub fn note_nonfinite(&mut self, pixel: u64, estimator: &'static str) {
+        if self.first_nonfinite.is_none_or(|(p, _)| pixel < p) {
+            self.first_nonfinite = Some((pixel, estimator));
+        }
+    }
+
+    pub fn first_nonfinite(&self) -> Option<(u64, &'static str)> {
+        self.first_nonfinite
+    }
+}
+
+/// What a render did and what it cost.
+#[derive(Clone, Debug, Default)]
+pub struct Stats {
+    pub global_emitted: u64,
+    pub global_stored: usize,
+    pub caustic_emitted: u64,
+    pub caustic_stored: usize,
+    /// Caustic-pass photons whose first hit was mirror or glass.
+    pub caustic_aimed_hits: u64,
+    /// Global-pass photons whose first hit was mirror or glass (what the
+    /// caustic pass would get without aiming).
+    pub global_specular_hits: u64,
+    pub cache_points: usize,
+    pub map_bytes: usize,
+    pub photon_rays: u64,
+    /// The camera pass's counters.
+    pub camera: Counters,
+    /// Pixels on the rim of a light's image, sampled with `edge_spp`.
+    pub edge_pixels: usize,
+    pub photon_time: Duration,
+    /// The map build: the photon maps (the caustic map's Morton sort and
+    /// kd-tree, both maps' grids), then the irradiance cache (estimates at
+    /// photons, their grid and tree).
+    pub tree_time: Duration,
+    pub cache_time: Duration,
+    pub camera_time: Duration,
+    /// Radius caps and photons per estimate (of the last pass when progressive).
+    pub r_global: f32,
+    pub r_caustic: f32,
+    pub k_global: usize,
+    pub k_caustic: usize,
+    /// Passes rendered (1 for a classic render).
+    pub passes: u32,
+    /// Photon maps the scene cannot use, not built.
+    pub skipped_global: bool,
+    pub skipped_caustic: bool,
+}
+
+impl Stats {
+    pub fn build_time(&self) -> Duration {
+        self.tree_time + self.cache_time
+    }
+
+    /// Adds another pass's counts and times (maps' sizes are the last pass's).
+    pub fn absorb(&mut self, o: Stats) {
+        self.global_emitted += o.global_emitted;
+        self.caustic_emitted += o.caustic_emitted;
+        self.caustic_aimed_hits += o.caustic_aimed_hits;
+        self.global_specular_hits += o.global_specular_hits;
+        self.photon_rays += o.photon_rays;
+        self.camera = self.camera.merge(o.camera);
+        self.photon_time += o.photon_time;
+        self.tree_time += o.tree_time;
+        self.cache_time += o.cache_time;
+        self.camera_time += o.camera_time;
+        self.passes += o.passes;
+        self.global_stored = o.global_stored;
+        self.caustic_stored = o.caustic_stored;
+        self.cache_points = o.cache_points;
+        self.map_bytes = o.map_bytes;
+        self.edge_pixels = o.edge_pixels;
+        self.r_global = o.r_global;
+        self.r_caustic = o.r_caustic;
+        self.k_global = o.k_global;
+        self.k_caustic = o.k_caustic;
+        self.skipped_global = o.skipped_global;
+        self.skipped_caustic = o.skipped_caustic;
+    }
+}
+
+/// The summary a program prints at the end of a render: every line within
+/// 100 columns.
+pub struct Summary<'a> {
+    pub stats: &'a Stats,
+    pub settings: &'a Settings,
+    pub threads: usize,
+    /// Reading the scene file and building the scene (its BVH).
+    pub load_time: Duration,
+    pub write_time: Duration,
+    pub total_time: Duration,
+    pub written: &'a [PathBuf],
+}
+
+impl Summary<'_> {
+    pub fn lines(&self) -> Vec<String> {
+        let s = self.stats;
+        let st = self.settings;
+        let secs = |d: Duration| d.as_secs_f64();
+        let per_s = |n: u64, d: Duration| n as f64 / secs(d).max(1e-9) / 1e6;
+        let pct = |a: u64, b: u64| 100.0 * a as f64 / b.max(1) as f64;
+        let method = match st.method {
+            Method::Photon => "photon mapping",
+            Method::Path => "path tracing",
+        };
+        let passes = if s.passes == 1 { "1 pass".to_string() } else { format!("{} passes", s.passes) };
+        let mut out =
+            vec![format!("photonmap: {method}, {passes}, {} threads, {} x {}", self.threads, st.width, st.height)];
+        out.push(format!("  scene load   {:>8.3} s", secs(self.load_time)));
+        if st.method == Method::Photon {
+            let last = if s.passes > 1 { " (last pass)" } else { "" };
+            out.push(format!(
+                "  global map   {:>11} emitted {:>11} stored{last}; {:.1}% first hit mirror/glass",
+                s.global_emitted,
+                s.global_stored,
+                pct(s.global_specular_hits, s.global_emitted)
+            ));
+            out.push(format!(
+                "  caustic map  {:>11} emitted {:>11} stored; {:.1}% aimed hit mirror/glass",
+                s.caustic_emitted,
+                s.caustic_stored,
+                pct(s.caustic_aimed_hits, s.caustic_emitted)
+            ));
+            out.push(format!(
+                "               {:.1} MB of maps, {} cache points; radius caps {:.3} global, {:.3} caustic",
+                s.map_bytes as f64 / 1e6,
+                s.cache_points,
+                s.r_global,
+                s.r_caustic
+            ));
+            out.push(format!(
+                "  photon pass  {:>8.3} s  {:>7.2} M photons/s  {:>7.2} M rays/s",
+                secs(s.photon_time),
+                per_s(s.global_emitted + s.caustic_emitted, s.photon_time),
+                per_s(s.photon_rays, s.photon_time)
+            ));
+            out.push(format!(
+                "  map build    {:>8.3} s  (maps {:.3} s, irradiance cache {:.3} s)",
+                secs(s.build_time()),
+                secs(s.tree_time),
+                secs(s.cache_time)
+            ));
+        }
+        let gather = if st.method == Method::Photon { format!(", {} gather", st.gather_rays) } else { String::new() };
+        out.push(format!(
+            "  camera pass  {:>8.3} s  {:>7.2} M rays/s  ({} spp{gather}, {} shadow rays)",
+            secs(s.camera_time),
+            per_s(s.camera.rays, s.camera_time),
+            st.spp,
+            st.shadow_rays
+        ));
+        if s.edge_pixels > 0 {
+            out.push(format!(
+                "               {} pixels on a light's rim took {} extra samples",
+                s.edge_pixels, st.edge_spp
+            ));
+        }
+        let c = &s.camera;
+        if c.caustic_estimates + c.caustic_reused > 0 {
+            out.push(format!(
+                "               {} caustic estimates, {} reused within a pixel ({:.0}%)",
+                c.caustic_estimates,
+                c.caustic_reused,
+                pct(c.caustic_reused, c.caustic_estimates + c.caustic_reused)
+            ));
+        }
+        let mut skipped = Vec::new();
+        if s.skipped_global {
+            skipped.push("the global map (nothing diffuse reflects light)".to_string());
+        }
+        if s.skipped_caustic {
+            skipped.push("the caustic map (no mirror or glass, or nothing diffuse)".to_string());
+        }
+        if c.shadow_rays_skipped > 0 {
+            skipped.push(format!("{} shadow rays to lights facing away", c.shadow_rays_skipped));
+        }
+        for (i, what) in skipped.iter().enumerate() {
+            out.push(format!("  {}  {what}", if i == 0 { "skipped:  " } else { "          " }));
+        }
+        out.push(format!("  write        {:>8.3} s", secs(self.write_time)));
+        for path in self.written {
+            out.push(format!("               {}", path.display()));
+        }
+        out.push(format!("  total        {:>8.3} s", secs(self.total_time)));
+        out
+    }
+}
