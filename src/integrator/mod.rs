@@ -16,12 +16,9 @@ pub mod whitted;
 
 pub use direct::{direct_light, direct_light_one_at_a_time};
 
-use crate::math::{Color, Frame, Ray};
-use crate::optics::{fresnel_dielectric, reflect, refract};
+use crate::math::{Color, Ray};
 use crate::sampling::Rng;
-use crate::scene::Hit;
 use crate::stats::Counters;
-use glam::Vec3;
 
 /// Which part of the radiance a camera sample estimates. A pixel's value is
 /// the sum of what reaches the eye from a light's own surface (directly or
@@ -86,26 +83,4 @@ impl Context<'_> {
             Color::ZERO
         }
     }
-}
-
-/// The two directions leaving a smooth dielectric, computed in the local
-/// frame of the surface.
-pub struct GlassBranches {
-    pub fresnel: f32,
-    pub reflected: Vec3,
-    /// Refracted direction and the radiance scale (n_i / n_t)^2 of a camera
-    /// path crossing into the other medium; `None` on total internal reflection.
-    pub refracted: Option<(Vec3, f32)>,
-}
-
-#[inline]
-pub fn glass_branches(hit: &Hit, ray: &Ray, ior: f32) -> GlassBranches {
-    let frame = Frame::from_normal(hit.facing_normal(ray.dir));
-    let wi = frame.to_local(-ray.dir);
-    let entering = ray.dir.dot(hit.normal) < 0.0;
-    let (n_i, n_t) = if entering { (1.0, ior) } else { (ior, 1.0) };
-    let fresnel = fresnel_dielectric(wi.z, n_i, n_t);
-    let reflected = frame.to_world(reflect(wi)).normalize();
-    let refracted = refract(wi, n_i / n_t).map(|wt| (frame.to_world(wt).normalize(), (n_i / n_t).powi(2)));
-    GlassBranches { fresnel: if refracted.is_some() { fresnel } else { 1.0 }, reflected, refracted }
 }

@@ -8,13 +8,11 @@
 //! cannot sample. Mirror and glass are sampled (Fresnel chooses the branch);
 //! Russian roulette on the path's throughput ends long paths without bias.
 
-use super::{direct_light, glass_branches, Context, Integrator, Part};
-use crate::material::{Lobe, Material};
+use super::{direct_light, Context, Integrator, Part};
+use crate::material::{Lobe, Scatter, Transport};
 use crate::math::{max_component, Color, Frame, Ray};
-use crate::sampling::{cosine_hemisphere, next_2d};
 use crate::scene::Scene;
 use rand::RngExt;
-use std::f32::consts::PI;
 
 /// Russian roulette starts after this many bounces.
 const RR_DEPTH: u32 = 3;
@@ -45,105 +43,46 @@ impl Integrator for PathIntegrator<'_> {
             ctx.counters.rays += 1;
             let Some(hit) = self.scene.intersect(&ray, departure) else { break };
             throughput *= self.scene.transmittance(departure, hit.t);
-            let material = *self.scene.material(hit.prim);
+            let material = self.scene.material(hit.prim);
             let wanted = match part {
                 Part::All => true,
                 Part::Emitted => specular_chain,
                 Part::Reflected => !specular_chain,
             };
-            if material != Material::Emitter && count_emission && wanted {
-                // A glowing surface's own light; after a diffuse bounce the
-                // shadow rays counted it.
+            if count_emission && wanted {
+                // A light's own surface, or a glowing one; after a diffuse
+                // bounce the shadow rays counted it.
                 radiance += throughput * self.scene.emitted(hit.prim, ray.dir);
             }
-            let wo = match material {
-                Material::Emitter => {
-                    let wanted = match part {
-                        Part::All => true,
-                        Part::Emitted => specular_chain,
-                        Part::Reflected => !specular_chain,
-                    };
-                    if count_emission && wanted {
-                        if let Some(light) = self.scene.light_of(hit.prim) {
-                            radiance += throughput * light.radiance_towards(ray.dir);
-                        }
-                    }
+            if material.is_emitter() {
+                break;
+            }
+            let n = hit.facing_normal(ray.dir);
+            let frame = Frame::from_normal(n);
+            let wo = frame.to_local(-ray.dir);
+            let entering = ray.dir.dot(hit.normal) < 0.0;
+            let scatter = if part == Part::Emitted {
+                // Only a specular lobe continues a specular chain.
+                let Some(b) = material.specular_branches(wo, entering, Transport::Radiance).choose(ctx.rng) else {
                     break;
-                }
-                Material::Lambertian { rho } => {
-                    if part == Part::Emitted || max_component(rho) <= 0.0 {
-                        break;
-                    }
-                    let n = hit.facing_normal(ray.dir);
-                    let direct = direct_light(self.scene, &hit, n, |_| rho / PI, self.shadow_rays, self.skip, ctx);
+                };
+                Scatter { wi: b.wi, weight: b.scale, lobe: Lobe::Specular }
+            } else {
+                if material.diffuse_rho().is_some() || material.glossy().is_some() {
+                    let brdf = |w| material.eval(wo, frame.to_local(w));
+                    let direct = direct_light(self.scene, &hit, n, brdf, self.shadow_rays, self.skip, ctx);
                     radiance += throughput * ctx.checked(direct, "path direct");
-                    count_emission = false;
-                    specular_chain = false;
-                    // Cosine sampling: f cos / pdf = rho.
-                    throughput *= rho;
-                    Frame::from_normal(n).to_world(cosine_hemisphere(next_2d(ctx.rng)))
                 }
-                Material::Phong(p) => {
-                    let n = hit.facing_normal(ray.dir);
-                    if part == Part::Emitted {
-                        // Only the mirror lobe continues a specular chain.
-                        if p.mirror <= 0.0 {
-                            break;
-                        }
-                        throughput *= p.mirror_rho();
-                        hit.mirrored(ray.dir)
-                    } else {
-                        let to_viewer = -ray.dir;
-                        let direct = direct_light(
-                            self.scene,
-                            &hit,
-                            n,
-                            |w| p.brdf(n, w, to_viewer),
-                            self.shadow_rays,
-                            self.skip,
-                            ctx,
-                        );
-                        radiance += throughput * ctx.checked(direct, "path direct");
-                        let Some((lobe, prob)) = p.choose_lobe(ctx.rng.random::<f32>()) else { break };
-                        match lobe {
-                            Lobe::Mirror => {
-                                count_emission = true;
-                                throughput *= p.mirror_rho() / prob;
-                                hit.mirrored(ray.dir)
-                            }
-                            Lobe::Diffuse => {
-                                count_emission = false;
-                                specular_chain = false;
-                                throughput *= p.diffuse_rho() / prob;
-                                Frame::from_normal(n).to_world(cosine_hemisphere(next_2d(ctx.rng)))
-                            }
-                            Lobe::Glossy => {
-                                count_emission = false;
-                                specular_chain = false;
-                                let Some((dir, w)) = p.sample_glossy(n, to_viewer, next_2d(ctx.rng)) else { break };
-                                throughput *= w / prob;
-                                dir
-                            }
-                        }
-                    }
-                }
-                Material::Mirror { reflectance } => {
-                    throughput *= reflectance;
-                    count_emission = true;
-                    hit.mirrored(ray.dir)
-                }
-                Material::Glass { ior, .. } => {
-                    count_emission = true;
-                    let b = glass_branches(&hit, &ray, ior);
-                    match b.refracted {
-                        Some((wt, scale)) if ctx.rng.random::<f32>() >= b.fresnel => {
-                            throughput *= scale;
-                            wt
-                        }
-                        _ => b.reflected,
-                    }
-                }
+                let Some(s) = material.sample(wo, entering, Transport::Radiance, ctx.rng) else { break };
+                s
             };
+            if scatter.lobe == Lobe::Specular {
+                count_emission = true;
+            } else {
+                count_emission = false;
+                specular_chain = false;
+            }
+            throughput *= scatter.weight;
             if depth >= RR_DEPTH {
                 let q = max_component(throughput).min(0.95);
                 if !(ctx.rng.random::<f32>() < q) {
@@ -154,7 +93,7 @@ impl Integrator for PathIntegrator<'_> {
             if max_component(throughput) <= 0.0 {
                 break;
             }
-            let (next, dep) = hit.spawn(wo.normalize());
+            let (next, dep) = hit.spawn(frame.to_world(scatter.wi).normalize());
             (ray, departure) = (next, Some(dep));
         }
         radiance

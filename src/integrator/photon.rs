@@ -16,15 +16,14 @@
 //! Gather rays that reach a light (directly or through mirrors and glass)
 //! add nothing: those paths belong to the first two rows.
 
-use super::{direct_light, glass_branches, Context, Integrator, Part};
-use crate::material::{Material, Phong};
-use crate::math::{max_component, Color, Frame, Ray};
+use super::{direct_light, Context, Integrator, Part};
+use crate::material::{Branch, Branches, Material, Transport};
+use crate::math::{Color, Frame, Ray};
 use crate::photon::irradiance_cache::{CellRange, IrradianceCache};
 use crate::photon::map::{ConeEstimate, PhotonMap, Scratch};
 use crate::sampling::{cosine_hemisphere, next_2d, stratified_2d};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;
-use rand::RngExt;
 use std::f32::consts::PI;
 
 /// Camera paths split into both the reflected and refracted branch at their
@@ -164,107 +163,84 @@ impl PhotonIntegrator<'_> {
         };
         let through = self.scene.transmittance(departure, hit.t);
         let w = w * through;
-        let radiance = match *self.scene.material(hit.prim) {
-            Material::Emitter if part == Part::Reflected => Color::ZERO,
-            Material::Emitter => self.scene.light_of(hit.prim).map_or(Color::ZERO, |l| l.radiance_towards(ray.dir)),
-            Material::Lambertian { rho } => self.surface(&hit, &ray, rho, None, depth, part, w, sh),
-            Material::Phong(p) => self.surface(&hit, &ray, p.diffuse_rho(), Some(&p), depth, part, w, sh),
-            Material::Mirror { reflectance } => self.mirror(&hit, &ray, reflectance, depth, part, w, sh),
-            Material::Glass { ior, .. } => {
-                if depth >= MAX_SPECULAR_DEPTH {
-                    return Color::ZERO;
-                }
-                let branches = glass_branches(&hit, &ray, ior);
-                let reflected = |s: &Self, w: Color, sh: &mut Shade| {
-                    let (next, dep) = hit.spawn(branches.reflected);
-                    s.trace(next, Some(dep), depth + 1, part, w, sh)
-                };
-                match branches.refracted {
-                    None => reflected(self, w, sh),
-                    Some((wt, radiance_scale)) => {
-                        let refracted = |s: &Self, w: Color, sh: &mut Shade| {
-                            let (next, dep) = hit.spawn(wt);
-                            radiance_scale * s.trace(next, Some(dep), depth + 1, part, w * radiance_scale, sh)
-                        };
-                        let r = branches.fresnel;
-                        if depth < SPLIT_DEPTH {
-                            r * reflected(self, w * r, sh) + (1.0 - r) * refracted(self, w * (1.0 - r), sh)
-                        } else if sh.ctx.rng.random::<f32>() < r {
-                            reflected(self, w, sh)
-                        } else {
-                            refracted(self, w, sh)
-                        }
-                    }
-                }
-            }
-        };
+        let material = self.scene.material(hit.prim);
+        // A light's own surface, or a glowing one.
+        let emitted = if part == Part::Reflected { Color::ZERO } else { self.scene.emitted(hit.prim, ray.dir) };
+        if material.is_emitter() {
+            return through * emitted;
+        }
+        let n = hit.facing_normal(ray.dir);
+        let frame = Frame::from_normal(n);
+        let wo = frame.to_local(-ray.dir);
+        let entering = ray.dir.dot(hit.normal) < 0.0;
+        let branches = material.specular_branches(wo, entering, Transport::Radiance);
+        let mut radiance = emitted;
+        if !branches.is_empty() {
+            radiance = self.specular(&hit, &frame, &branches, depth, part, w, sh) + radiance;
+        }
+        if part != Part::Emitted && (material.diffuse_rho().is_some() || material.glossy().is_some()) {
+            radiance += self.surface(&hit, material, &frame, wo, w, sh);
+        }
         through * radiance
     }
 
-    /// Radiance leaving a perfect mirror of `reflectance` along `-ray.dir`.
+    /// Radiance arriving along the specular branches, each scaled: all of
+    /// them along the first `SPLIT_DEPTH` vertices of a camera path (no
+    /// noise from the choice where it matters most), one chosen by its
+    /// share deeper.
     #[allow(clippy::too_many_arguments)]
-    fn mirror(
+    fn specular(
         &self,
         hit: &Hit,
-        ray: &Ray,
-        reflectance: Color,
+        frame: &Frame,
+        branches: &Branches,
         depth: u32,
         part: Part,
         w: Color,
         sh: &mut Shade,
     ) -> Color {
-        if depth >= MAX_SPECULAR_DEPTH || max_component(reflectance) <= 0.0 {
+        if depth >= MAX_SPECULAR_DEPTH {
             return Color::ZERO;
         }
-        let (next, dep) = hit.spawn(hit.mirrored(ray.dir));
-        reflectance * self.trace(next, Some(dep), depth + 1, part, w * reflectance, sh)
+        let follow = |s: &Self, b: &Branch, w: Color, sh: &mut Shade| {
+            let (next, dep) = hit.spawn(frame.to_world(b.wi).normalize());
+            b.scale * s.trace(next, Some(dep), depth + 1, part, w * b.scale, sh)
+        };
+        if depth < SPLIT_DEPTH {
+            branches.iter().map(|b| b.prob * follow(self, b, w * b.prob, sh)).fold(Color::ZERO, |a, b| a + b)
+        } else {
+            branches.choose(sh.ctx.rng).map_or(Color::ZERO, |b| follow(self, &b, w, sh))
+        }
     }
 
-    /// A surface with a Lambertian lobe `rho` and, for the Phong material,
-    /// a glossy lobe and a mirror lobe.
-    #[allow(clippy::too_many_arguments)]
+    /// Light reflected by a surface's smooth lobes: its diffuse lobe by
+    /// direct light, the caustic map and final gathering; its glossy lobe
+    /// by direct light and one gather ray.
     fn surface(
         &self,
         hit: &Hit,
-        ray: &Ray,
-        rho: Color,
-        phong: Option<&Phong>,
-        depth: u32,
-        part: Part,
+        material: &Material,
+        frame: &Frame,
+        wo: glam::Vec3,
         w: Color,
         sh: &mut Shade,
     ) -> Color {
-        let mirrored = match phong {
-            Some(p) => self.mirror(hit, ray, p.mirror_rho(), depth, part, w, sh),
-            None => Color::ZERO,
-        };
-        // A glowing surface's own light (zero for all but area lights).
-        let mirrored = match part {
-            Part::Reflected => mirrored,
-            _ => mirrored + self.scene.emitted(hit.prim, ray.dir),
-        };
-        let glossy = phong.is_some_and(|p| p.specular > 0.0);
-        if part == Part::Emitted || (max_component(rho) <= 0.0 && !glossy) {
-            return mirrored;
-        }
-        let n = hit.facing_normal(ray.dir);
-        let to_viewer = -ray.dir;
-        let brdf = |w: glam::Vec3| phong.map_or(rho / PI, |p| p.brdf(n, w, to_viewer));
+        let n = frame.n;
+        let brdf = |w: glam::Vec3| material.eval(wo, frame.to_local(w));
         let direct = direct_light(self.scene, hit, n, brdf, self.settings.shadow_rays, self.settings.skip, sh.ctx);
         let (mut caustic, mut indirect) = (Color::ZERO, Color::ZERO);
-        if max_component(rho) > 0.0 {
+        if let Some(rho) = material.diffuse_rho() {
             caustic = self.caustic(hit, n, rho, sh);
             indirect = self.indirect(hit, n, rho, w, sh);
         }
-        if let Some(p) = phong.filter(|_| glossy) {
+        if let Some(p) = material.glossy() {
             // One gather ray from the glossy lobe: indirect light it reflects.
-            if let Some((dir, weight)) = p.sample_glossy(n, to_viewer, next_2d(sh.ctx.rng)) {
-                let (next, dep) = hit.spawn(dir);
+            if let Some((wi, weight)) = p.sample_glossy(wo, next_2d(sh.ctx.rng)) {
+                let (next, dep) = hit.spawn(frame.to_world(wi).normalize());
                 indirect += weight * self.gather(next, dep, w * weight, sh);
             }
         }
-        mirrored
-            + self.checked(direct, "direct", sh)
+        self.checked(direct, "direct", sh)
             + self.checked(caustic, "caustic", sh)
             + self.checked(indirect, "indirect", sh)
     }
@@ -360,34 +336,19 @@ impl PhotonIntegrator<'_> {
                 break;
             };
             weight *= self.scene.transmittance(Some(dep), y.t);
-            let material = *self.scene.material(y.prim);
+            let material = self.scene.material(y.prim);
             if let Some(rho_y) = material.diffuse_rho() {
                 // A Phong surface's mirror lobe is not followed here: its
                 // share of indirect light is left out (notes/scene-format.md).
                 return GatherHit { point: y.point, normal: y.facing_normal(ray.dir), weight: weight * rho_y / PI };
             }
-            let next_dir = match material {
-                Material::Mirror { reflectance } => {
-                    weight *= reflectance;
-                    y.mirrored(ray.dir)
-                }
-                Material::Phong(p) if p.mirror > 0.0 => {
-                    weight *= p.mirror_rho();
-                    y.mirrored(ray.dir)
-                }
-                Material::Glass { ior, .. } => {
-                    let b = glass_branches(&y, &ray, ior);
-                    match b.refracted {
-                        Some((wt, scale)) if sh.ctx.rng.random::<f32>() >= b.fresnel => {
-                            weight *= scale;
-                            wt
-                        }
-                        _ => b.reflected,
-                    }
-                }
-                _ => break,
-            };
-            (ray, dep) = y.spawn(next_dir.normalize());
+            let frame = Frame::from_normal(y.facing_normal(ray.dir));
+            let entering = ray.dir.dot(y.normal) < 0.0;
+            let branches = material.specular_branches(frame.to_local(-ray.dir), entering, Transport::Radiance);
+            let Some(b) = branches.choose(sh.ctx.rng) else { break };
+            weight *= b.scale;
+            let next_dir = frame.to_world(b.wi).normalize();
+            (ray, dep) = y.spawn(next_dir);
         }
         GatherHit::default()
     }

@@ -13,16 +13,15 @@
 //! m_a = 1: its direct light is then exactly photonmap's.
 
 use crate::film::Film;
-use crate::material::{Material, Phong};
-use crate::math::{max_component, Color, Ray};
+use crate::material::{Material, Phong, Transport};
+use crate::math::{max_component, Color, Frame, Ray};
 use crate::progress::Mode;
 use crate::render::{camera_pass, CameraPass};
 use crate::sampling::{next_2d, stratified_2d, Rng};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;
-use std::f32::consts::PI;
 
-use super::{glass_branches, Context, Integrator, Part};
+use super::{Context, Integrator, Part};
 
 /// Shadow-ray samples per area light per shaded point (the course's lights
 /// are points; area lights get a soft shadow from this many samples).
@@ -41,42 +40,29 @@ impl Whitted<'_> {
             return Color::ZERO;
         };
         let through = self.scene.transmittance(departure, hit.t);
-        let glow = match self.scene.material(hit.prim) {
-            Material::Emitter => Color::ZERO,
-            _ => self.scene.emitted(hit.prim, ray.dir),
+        let material = self.scene.material(hit.prim);
+        let shaded = match material.course_phong() {
+            Some(p) => self.phong(&hit, ray, &p, depth, rng),
+            None => self.specular(&hit, ray, material, depth, rng),
         };
-        let c = glow
-            + match *self.scene.material(hit.prim) {
-                Material::Emitter => self.scene.light_of(hit.prim).map_or(Color::ZERO, |l| l.radiance_towards(ray.dir)),
-                Material::Phong(p) => self.phong(&hit, ray, &p, depth, rng),
-                Material::Lambertian { rho } => {
-                    let p = Phong {
-                        color: rho,
-                        ambient: 1.0,
-                        diffuse: 1.0 / PI,
-                        specular: 0.0,
-                        metalness: 0.0,
-                        shininess: 1.0,
-                        mirror: 0.0,
-                    };
-                    self.phong(&hit, ray, &p, depth, rng)
-                }
-                Material::Mirror { reflectance } => reflectance * self.bounce(&hit, ray, depth, rng),
-                Material::Glass { ior, .. } => {
-                    if depth >= self.max_depth {
-                        return Color::ZERO;
-                    }
-                    let b = glass_branches(&hit, ray, ior);
-                    let (r, dep) = hit.spawn(b.reflected);
-                    let mut c = b.fresnel * self.trace_ray(&r, Some(dep), depth + 1, rng);
-                    if let Some((wt, scale)) = b.refracted {
-                        let (t, dep) = hit.spawn(wt);
-                        c += (1.0 - b.fresnel) * scale * self.trace_ray(&t, Some(dep), depth + 1, rng);
-                    }
-                    c
-                }
-            };
-        through * c
+        // A light's own surface, or a glowing one.
+        through * (self.scene.emitted(hit.prim, ray.dir) + shaded)
+    }
+
+    /// Mirrors and glass: every branch (Fresnel's shares for glass) traced
+    /// on, to the depth limit.
+    fn specular(&self, hit: &Hit, ray: &Ray, material: &Material, depth: u32, rng: &mut Rng) -> Color {
+        if depth >= self.max_depth {
+            return Color::ZERO;
+        }
+        let frame = Frame::from_normal(hit.facing_normal(ray.dir));
+        let entering = ray.dir.dot(hit.normal) < 0.0;
+        let mut c = Color::ZERO;
+        for b in material.specular_branches(frame.to_local(-ray.dir), entering, Transport::Radiance).iter() {
+            let (next, dep) = hit.spawn(frame.to_world(b.wi).normalize());
+            c += b.prob * b.scale * self.trace_ray(&next, Some(dep), depth + 1, rng);
+        }
+        c
     }
 
     /// The bounce ray: `ray` reflected about the normal, if depth allows.

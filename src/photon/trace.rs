@@ -8,12 +8,9 @@
 
 use super::{Photon, PhotonBlocks};
 use crate::light::Light;
-use crate::material::{Lobe, Material};
+use crate::material::{Lobe, Transport};
 use crate::math::{max_component, Color, Frame, Ray};
-use crate::optics::{fresnel_dielectric, reflect, refract};
-use crate::sampling::{
-    concentric_disk, cosine_hemisphere, next_2d, stream, uniform_cone, uniform_cone_pdf, Domain, Rng,
-};
+use crate::sampling::{concentric_disk, next_2d, stream, uniform_cone, uniform_cone_pdf, Domain, Rng};
 use crate::scene::Scene;
 use crate::shape::Departure;
 use glam::Vec3;
@@ -269,102 +266,47 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
     };
     *power *= scene.transmittance(*departure, hit.t);
     let n = hit.facing_normal(ray.dir);
-    let material = *scene.material(hit.prim);
+    let material = scene.material(hit.prim);
     let first_specular = bounce_now == 0 && material.is_specular();
-    let frame = Frame::from_normal(n);
-    let wi = frame.to_local(-ray.dir);
     let stop = (false, first_specular);
-    // A cosine sample is unit length, and so, to rounding (a few ulps), is
-    // its image in the orthonormal frame: the diffuse bounces, most of the
-    // global pass, skip the normalisation, whose square root and division
-    // sat on the path from one hit to the next ray (-8% of the pass).
-    // Specular directions are normalised: a chain of mirror or glass
-    // bounces would carry their rounding from one to the next.
-    let specular = |w: Vec3| frame.to_world(w).normalize();
-    let dir = match material {
-        Material::Lambertian { rho } => {
-            match pass {
-                // Light reaching a diffuse surface straight from the light is
-                // not a caustic (shadow rays count it); after a diffuse
-                // bounce it is indirect light (final gathering counts it).
-                Pass::Caustic => {
-                    if *only_specular_so_far && *specular_bounces > 0 && max_component(rho) > 0.0 {
-                        out.push(Photon::new(hit.point, *power, n));
-                    }
-                    return stop;
-                }
-                Pass::Global => {
-                    if max_component(rho) > 0.0 {
-                        out.push(Photon::new(hit.point, *power, n));
-                    }
-                }
-            }
-            // Russian roulette with the albedo: survivors carry power * rho / p.
-            let p = max_component(rho);
-            if !(rng.random::<f32>() < p) {
-                return stop;
-            }
-            *power *= rho / p;
-            *only_specular_so_far = false;
-            frame.to_world(cosine_hemisphere(next_2d(rng)))
+    if material.diffuse_rho().is_some() {
+        // Light reaching a diffuse surface straight from the light is not
+        // a caustic (shadow rays count it); after a diffuse bounce it is
+        // indirect light (final gathering counts it).
+        let caustic = *only_specular_so_far && *specular_bounces > 0;
+        if pass == Pass::Global || caustic {
+            out.push(Photon::new(hit.point, *power, n));
         }
-        Material::Phong(p) => {
-            // The Lambertian lobe stores photons as a Lambertian surface
-            // does; roulette then picks the lobe that carries the photon on.
-            let rho = p.diffuse_rho();
-            let store = max_component(rho) > 0.0;
-            match pass {
-                Pass::Caustic if store && *only_specular_so_far && *specular_bounces > 0 => {
-                    out.push(Photon::new(hit.point, *power, n));
-                }
-                Pass::Global if store => out.push(Photon::new(hit.point, *power, n)),
-                _ => {}
-            }
-            let Some((lobe, prob)) = p.choose_lobe(rng.random::<f32>()) else {
-                return stop;
-            };
-            match lobe {
-                Lobe::Mirror => {
-                    *power *= p.mirror_rho() / prob;
-                    *specular_bounces += 1;
-                    specular(reflect(wi))
-                }
-                // A caustic path ends at its first non-specular bounce.
-                _ if pass == Pass::Caustic => return stop,
-                Lobe::Diffuse => {
-                    *power *= rho / prob;
-                    *only_specular_so_far = false;
-                    frame.to_world(cosine_hemisphere(next_2d(rng)))
-                }
-                Lobe::Glossy => {
-                    *only_specular_so_far = false;
-                    // Sampled in world space around the mirror direction.
-                    let Some((dir, w)) = p.sample_glossy(n, -ray.dir, next_2d(rng)) else {
-                        return stop;
-                    };
-                    *power *= w / prob;
-                    dir
-                }
-            }
-        }
-        Material::Mirror { reflectance } => {
-            *power *= reflectance;
-            *specular_bounces += 1;
-            specular(reflect(wi))
-        }
-        Material::Glass { ior, .. } => {
-            *specular_bounces += 1;
-            let entering = ray.dir.dot(hit.normal) < 0.0;
-            let (n_i, n_t) = if entering { (1.0, ior) } else { (ior, 1.0) };
-            let r = fresnel_dielectric(wi.z, n_i, n_t);
-            // Fresnel chooses the branch; the photon keeps its power.
-            match refract(wi, n_i / n_t) {
-                Some(wt) if rng.random::<f32>() >= r => specular(wt),
-                _ => specular(reflect(wi)),
-            }
-        }
-        Material::Emitter => return stop,
+    }
+    // Russian roulette: survivors carry power / p.
+    let p = material.photon_survival();
+    if p < 1.0 && !(rng.random::<f32>() < p) {
+        return stop;
+    }
+    let frame = Frame::from_normal(n);
+    let entering = ray.dir.dot(hit.normal) < 0.0;
+    let Some(scatter) = material.sample(frame.to_local(-ray.dir), entering, Transport::Importance, rng) else {
+        return stop;
     };
+    let dir = match scatter.lobe {
+        // A cosine sample is unit length, and so, to rounding (a few ulps),
+        // is its image in the orthonormal frame: the diffuse bounces, most
+        // of the global pass, skip the normalisation, whose square root and
+        // division sat on the path from one hit to the next ray (-8% of the
+        // pass).
+        Lobe::Diffuse => frame.to_world(scatter.wi),
+        // Specular directions are normalised: a chain of mirror or glass
+        // bounces would carry their rounding from one to the next.
+        Lobe::Specular => frame.to_world(scatter.wi).normalize(),
+        Lobe::Glossy => frame.to_world(scatter.wi).normalize(),
+    };
+    match scatter.lobe {
+        Lobe::Specular => *specular_bounces += 1,
+        // A caustic path ends at its first non-specular bounce.
+        _ if pass == Pass::Caustic => return stop,
+        _ => *only_specular_so_far = false,
+    }
+    *power *= scatter.weight / p;
     if max_component(*power) <= 0.0 || *bounce >= MAX_BOUNCES {
         return stop;
     }

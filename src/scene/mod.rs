@@ -273,12 +273,9 @@ impl Scene {
     /// less than one only inside absorbing glass (Beer–Lambert). A ray is
     /// inside a glass body when it left the glass against its outward normal.
     pub fn transmittance(&self, departure: Option<Departure>, t: f32) -> Color {
-        match departure {
-            Some(d) if !d.outward => match *self.material(d.prim) {
-                Material::Glass { absorption, .. } if absorption != Color::ZERO => (-absorption * t).exp(),
-                _ => Color::ONE,
-            },
-            _ => Color::ONE,
+        match departure.filter(|d| !d.outward).and_then(|d| self.material(d.prim).absorption()) {
+            Some(absorption) => (-absorption * t).exp(),
+            None => Color::ONE,
         }
     }
 
