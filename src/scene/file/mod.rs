@@ -9,8 +9,12 @@
 //! does not exist, an OBJ file that cannot be read).
 
 mod build;
+mod camera;
 mod defs;
+mod light;
 mod locate;
+mod material;
+mod shape;
 
 use super::SceneParts;
 use locate::Source;
