@@ -73,9 +73,9 @@ fn leaks(n: usize, seed: u64, intersect: impl Fn(&Scene, &Ray) -> Option<(u32, f
         // Both faces must face the origin, neither edge-on: a ray lying in a
         // face's plane runs along the face and may meet the tetrahedron
         // only where it reaches the floor (a silhouette edge; found by the
-        // 10M-ray run at stop 10: origin 0.0004 from a face's plane, the
-        // tetrahedron met at its base, where the floor, at the same
-        // distance, was reported instead).
+        // 10M-ray run: origin 0.0004 from a face's plane, the tetrahedron
+        // met at its base, where the floor, at the same distance, was
+        // reported instead).
         if !faces.iter().all(|(n, v)| n.normalize().dot(origin - *v) > 1e-3 * (origin - *v).length()) {
             continue;
         }

@@ -27,10 +27,9 @@ fn both_ways(parts: SceneParts) -> ((Film, Stats), (Film, Stats)) {
 /// within 3 standard deviations of the difference of two renders' means
 /// (estimated from four other seeds), or 1%.
 ///
-/// (Until stop 10 the mean's allowance was 3x the difference to one other
-/// seed; in the noisy scene with the light facing the ceiling that one
-/// difference happened to be 0.1% while the means spread by 25% from seed to
-/// seed, and any change to the random sequences could fail the test.)
+/// (Not 3x the difference to one other seed: in the noisy scene with the
+/// light facing the ceiling one such difference can be 0.1% while the means
+/// spread by 25% from seed to seed.)
 fn same_within_noise(scene: &Scene, a: &Film, b: &Film, label: &str) {
     same_within_noise_of(scene, &settings(false), a, b, label)
 }

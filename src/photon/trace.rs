@@ -70,7 +70,7 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
         // are faulted in only as photons are written.
         .map_init(Vec::new, |out: &mut Vec<Photon>, b| {
             let (block_rays, block_first) =
-                trace_range(scene, pass, n, seed, domain, b * BLOCK..((b + 1) * BLOCK).min(n), out);
+                trace_range::<LANES>(scene, pass, n, seed, domain, b * BLOCK..((b + 1) * BLOCK).min(n), out);
             rays.fetch_add(block_rays, Ordering::Relaxed);
             first_specular.fetch_add(block_first, Ordering::Relaxed);
             on_block(((b + 1) * BLOCK).min(n) - b * BLOCK);
@@ -198,12 +198,14 @@ struct Path {
 /// one before it (the hit, then the sampled direction, then the offset
 /// origin); segments of different photons do not, so the processor can
 /// overlap them when they are traced round-robin (5% off the pass; four
-/// lanes gained no more: notes/performance.md, stop 15).
+/// lanes gained no more: notes/performance.md).
 const LANES: usize = 2;
 
-/// Traces photons `range` of `pass`, `LANES` at a time, storing into `out`.
-/// Returns (rays cast, photons whose first hit was specular).
-fn trace_range(
+/// Traces photons `range` of `pass`, `L` at a time, storing into `out`.
+/// Returns (rays cast, photons whose first hit was specular). One lane is
+/// the plain loop, one photon after another: any number of lanes stores the
+/// same photons, in another order within the block (tested below).
+fn trace_range<const L: usize>(
     scene: &Scene,
     pass: Pass,
     n: u64,
@@ -234,7 +236,7 @@ fn trace_range(
         }
         None
     };
-    let mut lanes: [Option<Path>; LANES] = std::array::from_fn(|_| start(&mut next));
+    let mut lanes: [Option<Path>; L] = std::array::from_fn(|_| start(&mut next));
     loop {
         let mut alive = false;
         for lane in lanes.iter_mut() {
@@ -319,6 +321,36 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
 mod tests {
     use super::*;
     use crate::scene::{Eye, Scene};
+
+    /// Photons traced two at a time are the photons traced one after
+    /// another (each has its own random stream): the same set, every bit.
+    #[test]
+    fn lanes_store_the_photons_of_the_plain_loop() {
+        let scene = Scene::tncg15(Eye::One);
+        for pass in [Pass::Global, Pass::Caustic] {
+            let domain = if pass == Pass::Global { Domain::GlobalPhotons } else { Domain::CausticPhotons };
+            let run = |lanes: usize| {
+                let mut out = Vec::new();
+                let counts = match lanes {
+                    1 => trace_range::<1>(&scene, pass, 8000, 3, domain, 1000..5000, &mut out),
+                    _ => trace_range::<LANES>(&scene, pass, 8000, 3, domain, 1000..5000, &mut out),
+                };
+                let mut bits: Vec<[u32; 7]> = out
+                    .iter()
+                    .map(|p| {
+                        let [a, b, c] = p.pos.map(f32::to_bits);
+                        let [d, e, f] = p.power.map(f32::to_bits);
+                        [a, b, c, d, e, f, u32::from_le_bytes(p.normal.map(|x| x as u8))]
+                    })
+                    .collect();
+                bits.sort_unstable();
+                (bits, counts)
+            };
+            let (one, two) = (run(1), run(2));
+            assert!(one.0.len() > 1000, "{pass:?}: {} photons", one.0.len());
+            assert_eq!(one, two, "{pass:?}");
+        }
+    }
 
     #[test]
     fn same_seed_same_photons_on_any_thread_count() {
