@@ -21,7 +21,7 @@ fn furnace(le: f32, rho: f32) -> Scene {
 /// The furnace with an extra sphere of `material` in the middle of the room.
 fn furnace_with(le: f32, rho: f32, sphere: Option<Material>) -> Scene {
     let camera = Scene::tncg15_parts(Eye::Two).camera;
-    let lights = tncg15_room(0, 0, [0; 6])
+    let lights = tncg15_room(0, 0, [0; 6], 0)
         .into_iter()
         .map(|p| {
             let Shape::Triangle(t) = p.shape else { unreachable!() };
@@ -33,9 +33,16 @@ fn furnace_with(le: f32, rho: f32, sphere: Option<Material>) -> Scene {
     if let Some(m) = sphere {
         materials.push(m);
         let sphere = photonmap::shape::Sphere { center: glam::Vec3::new(5.0, 0.0, -2.0), radius: 2.0 };
-        prims.push(photonmap::scene::Prim { shape: Shape::Sphere(sphere), material: 1 });
+        prims.push(photonmap::scene::Prim { shape: Shape::Sphere(sphere), material: 1, object: 0 });
     }
-    Scene::from_parts(SceneParts { prims, materials, lights, ambient: Color::ZERO, camera })
+    Scene::from_parts(SceneParts {
+        prims,
+        shading_normals: Vec::new(),
+        materials,
+        lights,
+        ambient: Color::ZERO,
+        camera,
+    })
 }
 
 /// Renders the furnace `scene` with photon mapping (2e5 photons per map,

@@ -36,7 +36,7 @@ fn inside_room(p: Vec3) -> bool {
 /// silhouette are skipped: a ray grazing a convex solid may touch it or not.
 fn leaks(n: usize, seed: u64, intersect: impl Fn(&Scene, &Ray) -> Option<(u32, f32)>) -> usize {
     let scene = Scene::tncg15(Eye::One);
-    let triangle = |i: usize| match scene.prims[i].shape {
+    let triangle = |i: usize| match *scene.shape(i as u32) {
         Shape::Triangle(t) => t,
         _ => unreachable!("the first 24 primitives and 26..30 are triangles"),
     };
@@ -113,9 +113,9 @@ fn renderer(scene: &Scene, ray: &Ray) -> Option<(u32, f32)> {
 /// The course's Möller–Trumbore over the same primitives.
 fn moller_trumbore(scene: &Scene, ray: &Ray) -> Option<(u32, f32)> {
     let mut best: Option<(u32, f32)> = None;
-    for (i, p) in scene.prims.iter().enumerate() {
+    for i in 0..scene.prim_count() {
         let limit = best.map_or(f32::INFINITY, |b| b.1);
-        let t = match p.shape {
+        let t = match *scene.shape(i as u32) {
             Shape::Triangle(t) => t.moller_trumbore(ray, limit).map(|h| h.0),
             other => other.intersect(ray, limit, None).map(|h| h.t),
         };
@@ -297,14 +297,16 @@ fn degenerate_input_renders_finite_images() {
         Shape::Triangle(Triangle::new(p, p + Vec3::Z, p + Vec3::Z + Vec3::X * 1e-7)),
         Shape::Sphere(Sphere { center: Vec3::new(6.0, 0.0, -4.0), radius: 0.0 }),
     ];
-    parts.prims.extend(degenerate.iter().map(|&shape| Prim { shape, material: grey }));
+    parts.prims.extend(degenerate.iter().map(|&shape| Prim { shape, material: grey, object: 0 }));
     // A zero-radius glass sphere (an aiming target with no size) and a floor
     // triangle duplicated with another material (coincident faces).
     parts.materials.push(Material::glass(1.5));
     let glass = parts.materials.len() as u32 - 1;
-    parts
-        .prims
-        .push(Prim { shape: Shape::Sphere(Sphere { center: Vec3::new(7.0, 0.0, 0.0), radius: 0.0 }), material: glass });
+    parts.prims.push(Prim {
+        shape: Shape::Sphere(Sphere { center: Vec3::new(7.0, 0.0, 0.0), radius: 0.0 }),
+        material: glass,
+        object: 0,
+    });
     let mut copy = parts.prims[0];
     copy.material = 3;
     parts.prims.push(copy);
@@ -355,10 +357,13 @@ fn spawned_rays_do_not_skip_surfaces_that_are_close() {
     parts.materials.push(Material::Lambertian { rho: Color::splat(0.5) });
     let (a, b, c) = (Vec3::new(5.0, -10.0, 10.0), Vec3::new(15.0, -10.0, 10.0), Vec3::new(10.0, 10.0, 10.0));
     let up = Vec3::new(0.0, 0.0, 1e-4);
-    let floor = Prim { shape: Shape::Triangle(Triangle::new(a, b, c)), material: lambert };
-    let upper = Prim { shape: Shape::Triangle(Triangle::new(a + up, b + up, c + up)), material: lambert };
-    let ball =
-        Prim { shape: Shape::Sphere(Sphere { center: Vec3::new(10.0, 0.0, 11.0001), radius: 1.0 }), material: lambert };
+    let floor = Prim { shape: Shape::Triangle(Triangle::new(a, b, c)), material: lambert, object: 0 };
+    let upper = Prim { shape: Shape::Triangle(Triangle::new(a + up, b + up, c + up)), material: lambert, object: 0 };
+    let ball = Prim {
+        shape: Shape::Sphere(Sphere { center: Vec3::new(10.0, 0.0, 11.0001), radius: 1.0 }),
+        material: lambert,
+        object: 0,
+    };
     parts.prims = vec![floor, upper, ball];
     parts.lights.clear();
     let scene = Scene::from_parts(parts);

@@ -79,7 +79,7 @@ fn every_scene_in_scenes_loads() {
     for f in files {
         let file = load(&f).unwrap_or_else(|e| panic!("{e}"));
         let scene = Scene::from_parts(file.parts);
-        assert!(!scene.prims.is_empty() && !scene.lights.is_empty(), "{}", f.display());
+        assert!(scene.prim_count() > 0 && !scene.lights.is_empty(), "{}", f.display());
     }
 }
 
@@ -92,10 +92,10 @@ fn the_default_scene_file_is_the_built_in_room() {
     assert!(file.not_physical.is_empty());
     let from_file = Scene::from_parts(file.parts);
     let built_in = Scene::tncg15(Eye::One);
-    assert_eq!(from_file.prims.len(), built_in.prims.len());
-    for (a, b) in from_file.prims.iter().zip(&built_in.prims) {
-        assert_eq!(a.shape, b.shape);
-        assert_eq!(from_file.materials[a.material as usize], built_in.materials[b.material as usize]);
+    assert_eq!(from_file.prim_count(), built_in.prim_count());
+    for prim in 0..built_in.prim_count() as u32 {
+        assert_eq!(from_file.shape(prim), built_in.shape(prim));
+        assert_eq!(from_file.material(prim), built_in.material(prim));
     }
     assert_eq!((from_file.camera.width, from_file.camera.height), (800, 800));
     let settings = Settings { photons: 20_000, caustic_photons: 20_000, width: 48, height: 48, ..Settings::default() };

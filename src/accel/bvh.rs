@@ -95,6 +95,11 @@ impl Bvh {
         self.nodes.is_empty()
     }
 
+    /// Bytes held by the nodes.
+    pub fn memory_bytes(&self) -> usize {
+        self.nodes.capacity() * std::mem::size_of::<Node4>()
+    }
+
     /// Visits the leaves whose boxes the ray enters before `t_limit`, nearer
     /// boxes first; `visit` may shrink `t_limit`, and returns true to stop.
     pub fn traverse(&self, ray: &Ray, t_max: f32, mut visit: impl FnMut(std::ops::Range<usize>, &mut f32) -> bool) {

@@ -19,7 +19,7 @@
 //! a face but not part of its tiling (the tetrahedron's base on the floor).
 
 use crate::math::{gamma, Ray};
-use crate::shape::{Shape, ShapeHit, Triangle};
+use crate::shape::{Shape, ShapeHit, Triangle, FLAT};
 use glam::{Vec3, Vec4};
 
 /// Distinct planes tried, those of the largest triangles first: detection
@@ -333,7 +333,7 @@ impl Enclosure {
         let step = ray.dir * h.t;
         let point = ray.origin + step;
         let p_err = gamma(7) * (ray.origin.abs() + step.abs() + Vec3::splat(f.d.abs()));
-        (f.prim, ShapeHit { t: h.t, point, p_err, normal: f.normal })
+        (f.prim, ShapeHit { t: h.t, point, p_err, normal: f.normal, uv: [0.0; 2], shading: FLAT })
     }
 }
 

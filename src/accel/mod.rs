@@ -22,12 +22,18 @@ use enclosure::Enclosure;
 /// takes random rays from 157 to 87 ns (notes/performance.md).
 pub const FLAT_LIMIT: usize = 2;
 
+/// The scene's shapes, and the structures that find what a ray meets.
 pub struct Accel {
     /// Empty when the primitives are few enough to test them all.
     bvh: Bvh,
-    /// Shapes in leaf order, with their index in the scene (those of the
-    /// enclosure left out).
+    /// Every shape with its index in the scene: first those searched (in
+    /// the hierarchy's leaf order), then those of the enclosure. The scene
+    /// keeps no other copy.
     shapes: Vec<(Shape, u32)>,
+    /// How many of `shapes` the hierarchy (or the flat loop) searches.
+    searched: usize,
+    /// Where each primitive is in `shapes`.
+    slot: Vec<u32>,
     enclosure: Option<Enclosure>,
 }
 
@@ -56,16 +62,36 @@ impl Accel {
     }
 
     fn build(shapes: Vec<Shape>, enclosure: Option<Enclosure>, flat_limit: usize) -> Self {
-        let inside = |i: usize| !enclosure.as_ref().is_some_and(|e| e.contains(i as u32));
-        let rest: Vec<(Shape, u32)> =
-            shapes.iter().enumerate().filter(|&(i, _)| inside(i)).map(|(i, s)| (*s, i as u32)).collect();
-        if rest.len() <= flat_limit {
-            return Accel { bvh: Bvh::build(&[]).0, shapes: rest, enclosure };
+        let in_enclosure = |i: usize| enclosure.as_ref().is_some_and(|e| e.contains(i as u32));
+        let searched: Vec<u32> = (0..shapes.len()).filter(|&i| !in_enclosure(i)).map(|i| i as u32).collect();
+        let (bvh, order) = if searched.len() <= flat_limit {
+            (Bvh::build(&[]).0, searched)
+        } else {
+            let boxes: Vec<_> = searched.iter().map(|&i| shapes[i as usize].bounds()).collect();
+            let (bvh, order) = Bvh::build(&boxes);
+            (bvh, order.iter().map(|&k| searched[k as usize]).collect())
+        };
+        let count = order.len();
+        let order: Vec<u32> =
+            order.into_iter().chain((0..shapes.len() as u32).filter(|&i| in_enclosure(i as usize))).collect();
+        let mut slot = vec![0u32; shapes.len()];
+        for (k, &i) in order.iter().enumerate() {
+            slot[i as usize] = k as u32;
         }
-        let boxes: Vec<_> = rest.iter().map(|(s, _)| s.bounds()).collect();
-        let (bvh, order) = Bvh::build(&boxes);
-        let ordered = order.iter().map(|&i| rest[i as usize]).collect();
-        Accel { bvh, shapes: ordered, enclosure }
+        let shapes = order.iter().map(|&i| (shapes[i as usize], i)).collect();
+        Accel { bvh, shapes, searched: count, slot, enclosure }
+    }
+
+    /// The shape of primitive `prim`.
+    pub fn shape(&self, prim: u32) -> &Shape {
+        &self.shapes[self.slot[prim as usize] as usize].0
+    }
+
+    /// Bytes held: the shapes, their slots, the hierarchy's nodes.
+    pub fn memory_bytes(&self) -> usize {
+        self.shapes.capacity() * std::mem::size_of::<(Shape, u32)>()
+            + self.slot.capacity() * 4
+            + self.bvh.memory_bytes()
     }
 
     /// Where the ray meets the enclosure before `t_max` (never the face it
@@ -146,7 +172,7 @@ impl Accel {
     fn traverse<'s>(&'s self, ray: &Ray, t_max: f32, mut visit: impl FnMut(&'s Shape, u32, &mut f32) -> bool) {
         if self.bvh.is_empty() {
             let mut t_limit = t_max;
-            for (shape, index) in &self.shapes {
+            for (shape, index) in &self.shapes[..self.searched] {
                 if visit(shape, *index, &mut t_limit) {
                     return;
                 }

@@ -70,7 +70,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             w,
             h,
             cli.depth,
-            scene.prims.len(),
+            scene.prim_count(),
             scene.lights.len(),
             elapsed.as_secs_f64()
         );

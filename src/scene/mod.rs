@@ -14,14 +14,17 @@ mod room;
 
 pub use room::{tncg15_room, Eye};
 
-use crate::shape::{Departure, Disk, Ellipsoid, Shape, Sphere, Triangle};
+use crate::shape::{Departure, Disk, Ellipsoid, Shape, ShapeHit, Sphere, Triangle};
 use glam::{Vec2, Vec3};
 
-/// One primitive: its geometry and the index of its material.
+/// One primitive: its geometry, the index of its material, and the object
+/// it belongs to (a mesh, a sphere, the room: what a scene file lists as
+/// one shape).
 #[derive(Clone, Copy, Debug)]
 pub struct Prim {
     pub shape: Shape,
     pub material: u32,
+    pub object: u32,
 }
 
 /// A ray's nearest intersection with the scene.
@@ -32,6 +35,9 @@ pub struct Hit {
     pub p_err: Vec3,
     /// Geometric normal as the shape defines it.
     pub normal: Vec3,
+    /// The normal shading uses: interpolated from a mesh's vertex normals,
+    /// else the geometric one. On the geometric normal's side, unit.
+    pub shading_normal: Vec3,
     pub prim: u32,
 }
 
@@ -78,20 +84,27 @@ pub struct Target {
 }
 
 pub struct Scene {
-    pub prims: Vec<Prim>,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
     /// The Whitted course's ambient light A (photonmap requires zero).
     pub ambient: Color,
     pub camera: Camera,
-    /// Light index per primitive (`None` for non-emitters).
-    light_of_prim: Vec<Option<u32>>,
+    /// Per primitive: the index of its material, and of its area light
+    /// ([`NO_LIGHT`] for non-emitters). The shapes themselves live in the
+    /// accelerator, in the order it visits them.
+    prim_material: Vec<u32>,
+    prim_light: Vec<u32>,
+    /// Vertex normals of the smooth triangles ([`crate::shape::Triangle::shading`]).
+    shading_normals: Vec<[Vec3; 3]>,
     accel: Accel,
     bounds: (Vec3, Vec3),
     targets: Vec<Target>,
     /// Running sum of the lights' powers (largest channel), for choosing one.
     light_cdf: Vec<f32>,
 }
+
+/// Marks a primitive that is not a light's surface.
+const NO_LIGHT: u32 = u32::MAX;
 
 /// A light as a scene describes it, before the scene places it.
 #[derive(Clone, Copy, Debug)]
@@ -122,6 +135,8 @@ pub enum LightSpec {
 #[derive(Clone, Debug)]
 pub struct SceneParts {
     pub prims: Vec<Prim>,
+    /// Vertex normals of smooth triangles, indexed by their `shading`.
+    pub shading_normals: Vec<[Vec3; 3]>,
     pub materials: Vec<Material>,
     pub lights: Vec<LightSpec>,
     pub ambient: Color,
@@ -140,7 +155,7 @@ impl SceneParts {
                 Shape::Sphere(sp) => Shape::Sphere(Sphere { center: sp.center * s, radius: sp.radius * s }),
                 Shape::Disk(d) => Shape::Disk(scale_disk(d)),
                 Shape::Ellipsoid(e) => Shape::Ellipsoid(
-                    Ellipsoid::new(glam::Affine3A::from_scale(Vec3::splat(s)) * e.to_world).unwrap_or(e),
+                    Ellipsoid::new(glam::Affine3A::from_scale(Vec3::splat(s)) * e.to_world()).unwrap_or(e),
                 ),
             };
         }
@@ -167,13 +182,14 @@ impl Scene {
     /// `parts.prims`, in order), so that camera rays see them and photons are
     /// absorbed by them.
     pub fn from_parts(parts: SceneParts) -> Self {
-        let SceneParts { mut prims, mut materials, lights: specs, ambient, camera } = parts;
-        let mut light_of_prim = vec![None; prims.len()];
+        let SceneParts { mut prims, shading_normals, mut materials, lights: specs, ambient, camera } = parts;
+        let mut prim_light = vec![NO_LIGHT; prims.len()];
         let mut lights = Vec::new();
         let emitter = materials.len() as u32;
         if specs.iter().any(|l| matches!(l, LightSpec::Area { material: None, .. })) {
             materials.push(Material::Emitter);
         }
+        let objects = prims.iter().map(|p| p.object + 1).max().unwrap_or(0);
         for spec in &specs {
             if let LightSpec::Area { surface, radiance, material } = *spec {
                 let prim = prims.len() as u32;
@@ -182,8 +198,8 @@ impl Scene {
                     Emitting::Disk(d) => Shape::Disk(d),
                     Emitting::Triangle(t) => Shape::Triangle(t),
                 };
-                prims.push(Prim { shape, material });
-                light_of_prim.push(Some(lights.len() as u32));
+                prims.push(Prim { shape, material, object: objects + lights.len() as u32 });
+                prim_light.push(lights.len() as u32);
                 lights.push(Light::Area(AreaLight::new(surface, radiance, prim)));
             }
         }
@@ -226,8 +242,9 @@ impl Scene {
             .collect();
         // Lights stay out of the enclosure: their hits must name them.
         let group: Vec<Option<u32>> =
-            prims.iter().zip(&light_of_prim).map(|(p, l)| l.is_none().then_some(p.material)).collect();
-        let accel = Accel::with_enclosure(prims.iter().map(|p| p.shape).collect(), &group);
+            prims.iter().zip(&prim_light).map(|(p, &l)| (l == NO_LIGHT).then_some(p.material)).collect();
+        let prim_material = prims.iter().map(|p| p.material).collect();
+        let accel = Accel::with_enclosure(prims.into_iter().map(|p| p.shape).collect(), &group);
         let light_cdf = lights
             .iter()
             .scan(0.0f32, |acc, l| {
@@ -235,7 +252,19 @@ impl Scene {
                 Some(*acc)
             })
             .collect();
-        Scene { prims, materials, lights, ambient, camera, light_of_prim, accel, bounds: (lo, hi), targets, light_cdf }
+        Scene {
+            materials,
+            lights,
+            ambient,
+            camera,
+            prim_material,
+            prim_light,
+            shading_normals,
+            accel,
+            bounds: (lo, hi),
+            targets,
+            light_cdf,
+        }
     }
 
     pub fn intersect(&self, ray: &Ray, departure: Option<Departure>) -> Option<Hit> {
@@ -244,8 +273,35 @@ impl Scene {
             point: h.point,
             p_err: h.p_err,
             normal: h.normal,
+            shading_normal: self.shading_normal(&h),
             prim,
         })
+    }
+
+    /// A hit's vertex normals interpolated at its barycentrics, or the
+    /// geometric normal where there are none or the interpolation points
+    /// across the surface (the normals were oriented with the triangles'
+    /// winding when the mesh was read).
+    #[inline]
+    fn shading_normal(&self, h: &ShapeHit) -> Vec3 {
+        let Some(&[n0, n1, n2]) = self.shading_normals.get(h.shading as usize) else {
+            return h.normal;
+        };
+        let [u, v] = h.uv;
+        match ((1.0 - u - v) * n0 + u * n1 + v * n2).try_normalize() {
+            Some(n) if n.dot(h.normal) > 0.0 => n,
+            _ => h.normal,
+        }
+    }
+
+    /// Number of primitives (the area lights' surfaces included).
+    pub fn prim_count(&self) -> usize {
+        self.prim_material.len()
+    }
+
+    /// The geometry of primitive `prim`.
+    pub fn shape(&self, prim: u32) -> &Shape {
+        self.accel.shape(prim)
     }
 
     /// Whether the segment from the ray's origin to `t_max` is blocked by
@@ -255,7 +311,7 @@ impl Scene {
     }
 
     pub fn material(&self, prim: u32) -> &Material {
-        &self.materials[self.prims[prim as usize].material as usize]
+        &self.materials[self.prim_material[prim as usize] as usize]
     }
 
     /// Radiance that primitive `prim` emits itself towards `-dir` (zero
@@ -266,7 +322,10 @@ impl Scene {
 
     /// The area light whose surface primitive `prim` is.
     pub fn light_of(&self, prim: u32) -> Option<&AreaLight> {
-        self.light_of_prim[prim as usize].and_then(|i| self.lights[i as usize].area())
+        match self.prim_light[prim as usize] {
+            NO_LIGHT => None,
+            i => self.lights[i as usize].area(),
+        }
     }
 
     /// What is left of light that travelled `t` from a ray's `departure`:
@@ -334,7 +393,7 @@ impl Scene {
     /// the rest.
     pub fn needs(&self) -> Needs {
         let lit = crate::math::max_component(self.emitted_power()) > 0.0;
-        let diffuse = (0..self.prims.len() as u32).any(|i| self.material(i).diffuse_rho().is_some());
+        let diffuse = self.prim_material.iter().any(|&m| self.materials[m as usize].diffuse_rho().is_some());
         Needs {
             // Caustic paths need a mirror or glass object and a diffuse
             // surface to land on.
@@ -394,7 +453,7 @@ mod tests {
                 if let Some(next) = next {
                     if next.prim == hit.prim {
                         sphere_rehits += 1;
-                        let Shape::Sphere(s) = scene.prims[hit.prim as usize].shape else {
+                        let Shape::Sphere(s) = *scene.shape(hit.prim) else {
                             panic!("re-hit flat primitive {} at t = {}", hit.prim, next.t)
                         };
                         assert!(!dep.outward, "left a sphere outwards and met it again");
@@ -423,14 +482,14 @@ mod tests {
     fn default_scene_is_the_spec() {
         let scene = Scene::tncg15(Eye::One);
         // 24 room triangles + glass + mirror + 4 tetrahedron faces + the light.
-        assert_eq!(scene.prims.len(), 31);
+        assert_eq!(scene.prim_count(), 31);
         assert_eq!(scene.lights.len(), 1);
         let phi = scene.emitted_power();
         assert!((phi.x - std::f32::consts::PI.powi(2) * 10.0).abs() < 1e-3);
         // Every room normal points into the room: from the room's centre each
         // triangle's front faces the centre.
-        for p in &scene.prims[..24] {
-            let Shape::Triangle(t) = p.shape else { panic!() };
+        for prim in 0..24 {
+            let Shape::Triangle(t) = *scene.shape(prim) else { panic!() };
             assert!(t.normal.dot(Vec3::new(5.0, 0.0, 0.0) - t.v0) > 0.0);
             assert!((t.area() - 0.0).abs() > 1.0);
         }

@@ -22,7 +22,7 @@ pub enum Eye {
 /// normals point into the room: floor and ceiling as fans of six around the
 /// hexagon's centre, then two triangles per wall, walls in the spec's order
 /// P0-P1 … P5-P0.
-pub fn tncg15_room(floor: u32, ceiling: u32, walls: [u32; 6]) -> Vec<Prim> {
+pub fn tncg15_room(floor: u32, ceiling: u32, walls: [u32; 6], object: u32) -> Vec<Prim> {
     let hexagon = [
         Vec2::new(-3.0, 0.0),
         Vec2::new(0.0, 6.0),
@@ -37,7 +37,7 @@ pub fn tncg15_room(floor: u32, ceiling: u32, walls: [u32; 6]) -> Vec<Prim> {
     let mut room_triangle = |a: Vec3, b: Vec3, c: Vec3, material: u32| {
         let t = Triangle::new(a, b, c);
         let t = if t.normal.dot(inside - a) < 0.0 { Triangle::new(a, c, b) } else { t };
-        prims.push(Prim { shape: Shape::Triangle(t), material });
+        prims.push(Prim { shape: Shape::Triangle(t), material, object });
     };
     let centre = Vec2::new(5.0, 0.0);
     for (z, material) in [(floor_z, floor), (ceiling_z, ceiling)] {
@@ -78,18 +78,20 @@ impl Scene {
             materials.push(Material::Lambertian { rho });
             *wall = materials.len() as u32 - 1;
         }
-        let mut prims = tncg15_room(0, 0, walls);
+        let mut prims = tncg15_room(0, 0, walls, 0);
         materials.push(Material::glass(1.5));
         let glass = materials.len() as u32 - 1;
         prims.push(Prim {
             shape: Shape::Sphere(Sphere { center: Vec3::new(9.5, -2.0, -3.0), radius: 1.5 }),
             material: glass,
+            object: 1,
         });
         materials.push(Material::Mirror { reflectance: Color::splat(0.95) });
         let mirror = materials.len() as u32 - 1;
         prims.push(Prim {
             shape: Shape::Sphere(Sphere { center: Vec3::new(10.0, 2.5, -3.6), radius: 1.4 }),
             material: mirror,
+            object: 2,
         });
         materials.push(Material::Lambertian { rho: Color::new(0.9, 0.6, 0.1) });
         let tet = materials.len() as u32 - 1;
@@ -99,7 +101,7 @@ impl Scene {
             Vec3::new(12.4, 0.0, -5.0),
             Vec3::new(11.3, 0.0, -2.5),
         ) {
-            prims.push(Prim { shape: Shape::Triangle(t), material: tet });
+            prims.push(Prim { shape: Shape::Triangle(t), material: tet, object: 3 });
         }
         let light = Disk { center: Vec3::new(8.0, 0.0, 4.999), normal: -Vec3::Z, radius: 1.0 };
         let eye_point = match eye {
@@ -120,6 +122,7 @@ impl Scene {
         );
         SceneParts {
             prims,
+            shading_normals: Vec::new(),
             materials,
             lights: vec![LightSpec::Area {
                 surface: Emitting::Disk(light),

@@ -1,18 +1,21 @@
 //! The CS475 assignment's transformed unit sphere (an ellipsoid under a
 //! non-uniform scale).
 
-use super::{ShapeHit, Sphere};
+use super::{ShapeHit, Sphere, FLAT};
 use crate::math::{gamma, Ray};
-use glam::{Affine3A, Vec3};
+use glam::{Affine3, Affine3A, Vec3};
 
-/// The assignment's transformed unit sphere: `to_world` maps the unit sphere
-/// at the origin onto the shape (an ellipsoid under non-uniform scale). A ray
-/// is carried into object space, met there by the unit sphere, and the hit's
-/// normal is carried back by the inverse transpose.
+/// The assignment's transformed unit sphere: a transform maps the unit
+/// sphere at the origin onto the shape (an ellipsoid under non-uniform
+/// scale). A ray is carried into object space, met there by the unit
+/// sphere, and the hit's normal is carried back by the inverse transpose.
+///
+/// Only the inverse is kept (48 bytes, not SIMD-aligned), so that a
+/// primitive of the scene stays small: every triangle is as large as the
+/// largest shape. The forward map is rebuilt where a hit is recorded.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ellipsoid {
-    pub to_world: Affine3A,
-    to_object: Affine3A,
+    to_object: Affine3,
 }
 
 impl Ellipsoid {
@@ -23,7 +26,14 @@ impl Ellipsoid {
             return None;
         }
         let to_object = to_world.inverse();
-        to_object.is_finite().then_some(Ellipsoid { to_world, to_object })
+        let to_object = Affine3::from_mat3_translation(to_object.matrix3.into(), to_object.translation.into());
+        (to_object.is_finite() && to_object.inverse().is_finite()).then_some(Ellipsoid { to_object })
+    }
+
+    /// The map from the unit sphere to the shape.
+    pub fn to_world(&self) -> Affine3A {
+        let w = self.to_object.inverse();
+        Affine3A::from_mat3_translation(w.matrix3, w.translation)
     }
 
     /// The ray in object space with a unit direction, and the factor that
@@ -51,23 +61,24 @@ impl Ellipsoid {
         let (local_ray, len) = self.object_ray(ray).unwrap_or((*ray, 1.0));
         let unit = Sphere { center: Vec3::ZERO, radius: 1.0 }.record(&local_ray, t * len);
         let local = unit.point;
-        let point = self.to_world.transform_point3(local);
-        let m = self.to_world.matrix3;
+        let to_world = self.to_world();
+        let point = to_world.transform_point3(local);
+        let m = to_world.matrix3;
         let abs_m = glam::Mat3A::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
         // The object point's error carried through the matrix, plus the
         // rounding of the matrix product and the translation.
         let p_err = Vec3::from(abs_m * glam::Vec3A::from(unit.p_err + gamma(4) * local.abs()))
-            + gamma(4)
-                * (Vec3::from(abs_m * glam::Vec3A::from(local.abs())) + Vec3::from(self.to_world.translation.abs()));
-        let normal = (self.to_object.matrix3.transpose() * glam::Vec3A::from(local)).normalize();
-        ShapeHit { t, point, p_err, normal: Vec3::from(normal) }
+            + gamma(4) * (Vec3::from(abs_m * glam::Vec3A::from(local.abs())) + Vec3::from(to_world.translation.abs()));
+        let normal = (self.to_object.matrix3.transpose() * local).normalize();
+        ShapeHit { t, point, p_err, normal, uv: [0.0; 2], shading: FLAT }
     }
 
     pub fn bounds(&self) -> (Vec3, Vec3) {
         // Extent along axis i of the image of the unit sphere: |row i of M|.
-        let m = self.to_world.matrix3.transpose();
+        let to_world = self.to_world();
+        let m = to_world.matrix3.transpose();
         let e = Vec3::new(m.x_axis.length(), m.y_axis.length(), m.z_axis.length());
-        let c = Vec3::from(self.to_world.translation);
+        let c = Vec3::from(to_world.translation);
         (c - e, c + e)
     }
 }

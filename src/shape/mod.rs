@@ -18,7 +18,7 @@ mod triangle;
 pub use disk::Disk;
 pub use ellipsoid::Ellipsoid;
 pub use sphere::Sphere;
-pub use triangle::{tetrahedron, RayShear, Triangle};
+pub use triangle::{tetrahedron, RayShear, Triangle, FLAT};
 
 use crate::math::{Ray, Vertex};
 use glam::Vec3;
@@ -40,6 +40,11 @@ pub struct ShapeHit {
     pub p_err: Vec3,
     /// Unit geometric normal as the shape defines it (not flipped to face the ray).
     pub normal: Vec3,
+    /// A triangle's barycentric weights of v1 and v2 at the hit (zero for
+    /// other shapes).
+    pub uv: [f32; 2],
+    /// The triangle's vertex normals ([`Triangle::shading`]), or [`FLAT`].
+    pub shading: u32,
 }
 
 /// The geometry of one primitive.
@@ -104,7 +109,7 @@ impl Shape {
             Shape::Disk(d) => (d.center, d.radius),
             Shape::Ellipsoid(e) => {
                 let (lo, hi) = e.bounds();
-                (Vec3::from(e.to_world.translation), ((hi - lo) * 0.5).length())
+                (Vec3::from(e.to_world().translation), ((hi - lo) * 0.5).length())
             }
         }
     }
@@ -121,8 +126,8 @@ impl Shape {
             Shape::Disk(d) => (d.center.dot(u), d.radius * (u - d.normal * u.dot(d.normal)).length()),
             // x = M y + c over |y| = 1: c.u +- |M^T u|.
             Shape::Ellipsoid(e) => (
-                Vec3::from(e.to_world.translation).dot(u),
-                (e.to_world.matrix3.transpose() * glam::Vec3A::from(u)).length(),
+                Vec3::from(e.to_world().translation).dot(u),
+                (e.to_world().matrix3.transpose() * glam::Vec3A::from(u)).length(),
             ),
         };
         (c - half, c + half)
@@ -140,5 +145,17 @@ impl Shape {
             }
             Shape::Ellipsoid(e) => e.bounds(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every primitive is as large as the largest shape: a triangle of a
+    /// million-triangle mesh pays for the ellipsoid's transform.
+    #[test]
+    fn a_shape_stays_small() {
+        assert!(std::mem::size_of::<Shape>() <= 56, "{} bytes", std::mem::size_of::<Shape>());
     }
 }

@@ -42,16 +42,18 @@ pub struct Triangle {
     pub v1: Vertex,
     pub v2: Vertex,
     pub normal: Vec3,
-    /// Edges v1 - v0 and v2 - v0, kept for Möller–Trumbore.
-    e1: Vec3,
-    e2: Vec3,
+    /// The scene's vertex normals of this triangle (an index into
+    /// [`crate::scene::Scene`]'s table), or [`FLAT`]: shaded with `normal`.
+    pub shading: u32,
 }
+
+/// A triangle shaded with its geometric normal.
+pub const FLAT: u32 = u32::MAX;
 
 impl Triangle {
     pub fn new(v0: Vertex, v1: Vertex, v2: Vertex) -> Self {
-        let (e1, e2) = (v1 - v0, v2 - v0);
-        let normal = e1.cross(e2).try_normalize().unwrap_or(Vec3::ZERO);
-        Triangle { v0, v1, v2, normal, e1, e2 }
+        let normal = (v1 - v0).cross(v2 - v0).try_normalize().unwrap_or(Vec3::ZERO);
+        Triangle { v0, v1, v2, normal, shading: FLAT }
     }
 
     pub fn area(&self) -> f32 {
@@ -153,8 +155,9 @@ impl Triangle {
         if self.normal == Vec3::ZERO {
             return None;
         }
-        let p = ray.dir.cross(self.e2);
-        let det = p.dot(self.e1);
+        let (e1, e2) = (self.v1 - self.v0, self.v2 - self.v0);
+        let p = ray.dir.cross(e2);
+        let det = p.dot(e1);
         if det == 0.0 || !det.is_finite() {
             return None;
         }
@@ -164,12 +167,12 @@ impl Triangle {
         if !(0.0..=1.0).contains(&u) {
             return None;
         }
-        let q = tv.cross(self.e1);
+        let q = tv.cross(e1);
         let v = q.dot(ray.dir) * inv;
         if v < 0.0 || u + v > 1.0 {
             return None;
         }
-        let t = q.dot(self.e2) * inv;
+        let t = q.dot(e2) * inv;
         (t > 0.0 && t < t_max).then_some((t, u, v))
     }
 
@@ -180,7 +183,7 @@ impl Triangle {
         let w = 1.0 - u - v;
         let point = w * self.v0 + u * self.v1 + v * self.v2;
         let p_err = gamma(7) * ((w * self.v0).abs() + (u * self.v1).abs() + (v * self.v2).abs());
-        ShapeHit { t, point, p_err, normal: self.normal }
+        ShapeHit { t, point, p_err, normal: self.normal, uv: [u, v], shading: self.shading }
     }
 }
 

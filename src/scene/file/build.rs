@@ -19,6 +19,7 @@ pub fn build(src: Source, def: FileDef) -> Result<SceneFile, SceneError> {
         materials: Vec::new(),
         names: BTreeMap::new(),
         prims: Vec::new(),
+        shading_normals: Vec::new(),
         lights: Vec::new(),
         not_physical: Vec::new(),
     }
@@ -30,6 +31,7 @@ pub(super) struct Builder<'a> {
     pub(super) materials: Vec<Material>,
     pub(super) names: BTreeMap<String, u32>,
     pub(super) prims: Vec<Prim>,
+    pub(super) shading_normals: Vec<[Vec3; 3]>,
     pub(super) lights: Vec<LightSpec>,
     pub(super) not_physical: Vec<SceneError>,
 }
@@ -160,7 +162,14 @@ impl Builder<'_> {
                  light itself (remove `ambient` or set it to [0, 0, 0])",
             ));
         }
-        let parts = SceneParts { prims: self.prims, materials: self.materials, lights: self.lights, ambient, camera };
+        let parts = SceneParts {
+            prims: self.prims,
+            shading_normals: self.shading_normals,
+            materials: self.materials,
+            lights: self.lights,
+            ambient,
+            camera,
+        };
         Ok(SceneFile { parts, rays_per_pixel_edge, not_physical: self.not_physical })
     }
 }

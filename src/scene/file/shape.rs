@@ -26,6 +26,7 @@ pub struct ShapeDef {
     pub radius: Option<Spanned<f32>>,
     pub normal: Option<Spanned<V3>>,
     pub file: Option<Spanned<String>>,
+    pub face_normals: Option<Spanned<bool>>,
     pub transform: Option<Vec<Spanned<StepDef>>>,
     pub floor: Option<Spanned<String>>,
     pub ceiling: Option<Spanned<String>>,
@@ -91,6 +92,7 @@ impl Builder<'_> {
             ("radius", d.radius.as_ref().map(|x| x.span())),
             ("normal", d.normal.as_ref().map(|x| x.span())),
             ("file", d.file.as_ref().map(|x| x.span())),
+            ("face_normals", d.face_normals.as_ref().map(|x| x.span())),
             ("transform", d.transform.as_ref().and_then(|x| x.first()).map(|x| x.span())),
             ("floor", d.floor.as_ref().map(|x| x.span())),
             ("ceiling", d.ceiling.as_ref().map(|x| x.span())),
@@ -121,19 +123,36 @@ impl Builder<'_> {
                 self.reject(&kind, &only(&["material", "emission", "vertices"]))?;
                 let v = vertices(3)?;
                 let t = Triangle::new(v[0], v[1], v[2]);
-                self.triangles(&kind, &d.material, emission, &[t], &d.vertices)?;
+                self.triangles(i, &kind, &d.material, emission, &[t], None, &d.vertices)?;
             }
             "mesh" => {
-                self.reject(&kind, &only(&["material", "emission", "file", "transform"]))?;
+                self.reject(&kind, &only(&["material", "emission", "file", "face_normals", "transform"]))?;
                 let file = self.need(&d.file, &kind, "file")?;
                 let m = self.transform(i, &d.transform)?;
                 let obj_path = self.src.path.parent().unwrap_or(Path::new(".")).join(file.value);
-                let triangles = load_obj(&obj_path)
-                    .map_err(|e| self.src.error(file.span.clone(), file.field.clone(), e))?
-                    .into_iter()
-                    .map(|[a, b, c]| Triangle::new(m.transform_point3(a), m.transform_point3(b), m.transform_point3(c)))
-                    .collect::<Vec<_>>();
-                self.triangles(&kind, &d.material, emission, &triangles, &d.vertices)?;
+                let mesh = load_obj(&obj_path).map_err(|e| self.src.error(file.span.clone(), file.field.clone(), e))?;
+                let triangles: Vec<Triangle> = mesh
+                    .triangles
+                    .iter()
+                    .map(|[a, b, c]| {
+                        Triangle::new(m.transform_point3(*a), m.transform_point3(*b), m.transform_point3(*c))
+                    })
+                    .collect();
+                // Normals go through the inverse transpose (a mirroring
+                // transform flips the winding and the normals alike).
+                let flat = d.face_normals.as_ref().is_some_and(|f| *f.get_ref()) || emission.is_some();
+                let normal_map = m.matrix3.inverse().transpose();
+                let normals = mesh.normals.filter(|_| !flat).map(|normals| {
+                    normals
+                        .iter()
+                        .map(|n| {
+                            n.map(|v| {
+                                Vec3::from(normal_map * glam::Vec3A::from(v)).try_normalize().unwrap_or(Vec3::ZERO)
+                            })
+                        })
+                        .collect::<Vec<_>>()
+                });
+                self.triangles(i, &kind, &d.material, emission, &triangles, normals.as_deref(), &d.vertices)?;
             }
             "sphere" | "ellipsoid" | "tetrahedron" | "disk" | "room" if emission.is_some() => {
                 let e = d.emission.as_ref().map(|e| e.span()).unwrap_or(kind.span.clone());
@@ -148,7 +167,7 @@ impl Builder<'_> {
                 let material = self.material_ref(&kind, &d.material)?;
                 let center = self.finite(&self.need(&d.center, &kind, "center")?)?;
                 let radius = self.number(&self.need(&d.radius, &kind, "radius")?, 0.0, f32::INFINITY, true)?;
-                self.prims.push(Prim { shape: Shape::Sphere(Sphere { center, radius }), material });
+                self.prims.push(Prim { shape: Shape::Sphere(Sphere { center, radius }), material, object: i as u32 });
             }
             "ellipsoid" => {
                 self.reject(&kind, &only(&["material", "transform"]))?;
@@ -156,14 +175,14 @@ impl Builder<'_> {
                 let m = self.transform(i, &d.transform)?;
                 let e = Ellipsoid::new(m)
                     .ok_or_else(|| self.src.error(kind.span.clone(), f("transform"), "the transform is singular"))?;
-                self.prims.push(Prim { shape: Shape::Ellipsoid(e), material });
+                self.prims.push(Prim { shape: Shape::Ellipsoid(e), material, object: i as u32 });
             }
             "tetrahedron" => {
                 self.reject(&kind, &only(&["material", "vertices"]))?;
                 let material = self.material_ref(&kind, &d.material)?;
                 let v = vertices(4)?;
                 for t in tetrahedron(v[0], v[1], v[2], v[3]) {
-                    self.prims.push(Prim { shape: Shape::Triangle(t), material });
+                    self.prims.push(Prim { shape: Shape::Triangle(t), material, object: i as u32 });
                 }
             }
             "disk" => {
@@ -172,7 +191,11 @@ impl Builder<'_> {
                 let center = self.finite(&self.need(&d.center, &kind, "center")?)?;
                 let normal = self.direction(&self.need(&d.normal, &kind, "normal")?)?;
                 let radius = self.number(&self.need(&d.radius, &kind, "radius")?, 0.0, f32::INFINITY, true)?;
-                self.prims.push(Prim { shape: Shape::Disk(Disk { center, normal, radius }), material });
+                self.prims.push(Prim {
+                    shape: Shape::Disk(Disk { center, normal, radius }),
+                    material,
+                    object: i as u32,
+                });
             }
             "room" => {
                 self.reject(&kind, &only(&["floor", "ceiling", "walls"]))?;
@@ -190,7 +213,7 @@ impl Builder<'_> {
                 for (w, name) in walls.iter_mut().zip(walls_def.value.iter()) {
                     *w = self.material_ref(&kind, &Some(name.clone()))?;
                 }
-                self.prims.extend(tncg15_room(floor, ceiling, walls));
+                self.prims.extend(tncg15_room(floor, ceiling, walls, i as u32));
             }
             other => {
                 return self.fail(
@@ -207,16 +230,30 @@ impl Builder<'_> {
 
     /// Triangles of a triangle or mesh shape: lights when emissive, else
     /// primitives of the named material. Zero-area triangles are dropped.
+    /// Triangles of shape `i` (with their vertex normals, if smooth).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn triangles(
         &mut self,
+        i: usize,
         kind: &At<String>,
         material: &Option<Spanned<String>>,
         emission: Option<Color>,
         triangles: &[Triangle],
+        normals: Option<&[[Vec3; 3]]>,
         vertices: &Option<Spanned<Vec<V3>>>,
     ) -> Result<(), SceneError> {
-        let kept: Vec<Triangle> =
-            triangles.iter().copied().filter(|t| t.area() > 0.0 && t.normal.is_finite()).collect();
+        let mut kept = Vec::with_capacity(triangles.len());
+        for (j, t) in triangles.iter().enumerate() {
+            if !(t.area() > 0.0 && t.normal.is_finite()) {
+                continue;
+            }
+            let mut t = *t;
+            if let Some(n) = normals.map(|n| n[j]).filter(|n| n.iter().all(|v| *v != Vec3::ZERO)) {
+                t.shading = self.shading_normals.len() as u32;
+                self.shading_normals.push(n);
+            }
+            kept.push(t);
+        }
         if kept.is_empty() {
             let span = vertices.as_ref().map_or(kind.span.clone(), |v| v.span());
             return self.fail(span, &kind.field.replace(".type", ""), "has no triangle of non-zero area");
@@ -233,7 +270,8 @@ impl Builder<'_> {
             }
             None => {
                 let material = self.material_ref(kind, material)?;
-                self.prims.extend(kept.into_iter().map(|t| Prim { shape: Shape::Triangle(t), material }));
+                let object = i as u32;
+                self.prims.extend(kept.into_iter().map(|t| Prim { shape: Shape::Triangle(t), material, object }));
             }
         }
         Ok(())
