@@ -66,7 +66,7 @@ fn main() {
 fn mesh_scene() {
     let scene = Scene::tncg15(Eye::One);
     let mut shapes: Vec<Shape> = (0..scene.prim_count() as u32).map(|i| *scene.shape(i)).collect();
-    let torus = photonmap::scene::mesh::torus(glam::Vec3::new(8.0, 0.0, -2.0), 2.2, 0.8, 250, 200);
+    let torus = photonmap::scene::procedural::torus(glam::Vec3::new(8.0, 0.0, -2.0), 2.2, 0.8, 250, 200).triangles();
     shapes.extend(torus.iter().map(|[a, b, c]| Shape::Triangle(Triangle::new(*a, *b, *c))));
     println!("\nmesh scene: {} primitives (100,000 torus triangles + the room)", shapes.len());
     let camera = scene.camera.with_resolution(400, 400);

@@ -197,7 +197,7 @@ mod tests {
     /// every triangle (91,080 tests per random ray; 330 us per camera ray).
     #[test]
     fn a_ray_that_misses_every_box_tests_no_primitive() {
-        let torus = crate::scene::mesh::torus(glam::Vec3::ZERO, 2.0, 0.5, 100, 50);
+        let torus = crate::scene::procedural::torus(glam::Vec3::ZERO, 2.0, 0.5, 100, 50).triangles();
         let shapes: Vec<Shape> = torus.iter().map(|[a, b, c]| Shape::Triangle(Triangle::new(*a, *b, *c))).collect();
         let accel = Accel::new(shapes);
         let miss = Ray::new(glam::Vec3::new(0.0, 0.0, 5.0), glam::Vec3::new(1.0, 0.0, 0.0));
@@ -339,7 +339,7 @@ mod tests {
     /// the same rays hit, at the same distance, and the same are occluded.
     #[test]
     fn a_deep_hierarchy_agrees_with_the_flat_loop() {
-        let torus = crate::scene::mesh::torus(glam::Vec3::ZERO, 2.0, 0.5, 100, 50);
+        let torus = crate::scene::procedural::torus(glam::Vec3::ZERO, 2.0, 0.5, 100, 50).triangles();
         let shapes: Vec<Shape> = torus.iter().map(|[a, b, c]| Shape::Triangle(Triangle::new(*a, *b, *c))).collect();
         let tree = Accel::new(shapes.clone());
         assert!(tree.bvh.len() > 100, "{} nodes", tree.bvh.len());

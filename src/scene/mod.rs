@@ -10,6 +10,7 @@ use crate::material::Material;
 use crate::math::{max_component, offset_ray_origin, Color, Ray, Vertex};
 pub mod file;
 pub mod mesh;
+pub mod procedural;
 mod room;
 
 pub use room::{tncg15_room, Eye};

@@ -22,6 +22,7 @@ pub fn build(src: Source, def: FileDef) -> Result<SceneFile, SceneError> {
         shading_normals: Vec::new(),
         lights: Vec::new(),
         not_physical: Vec::new(),
+        origins: super::Origins { path: src.path.to_path_buf(), ..Default::default() },
     }
     .build(def)
 }
@@ -34,6 +35,7 @@ pub(super) struct Builder<'a> {
     pub(super) shading_normals: Vec<[Vec3; 3]>,
     pub(super) lights: Vec<LightSpec>,
     pub(super) not_physical: Vec<SceneError>,
+    pub(super) origins: super::Origins,
 }
 
 /// A value with its span and its place in the file, for checks.
@@ -140,14 +142,21 @@ impl Builder<'_> {
                 }
             }
             self.materials.push(material);
+            let place = self.place(m.get_ref().kind.span(), format!("materials.{name}"));
+            self.origins.materials.push(place);
             self.names.insert(name.clone(), self.materials.len() as u32 - 1);
         }
         for (i, s) in def.shapes.iter().enumerate() {
+            let place = self.place(s.get_ref().kind.span(), format!("shapes[{i}]"));
+            self.origins.objects.push(place);
             self.shape(i, s)?;
         }
         for (i, l) in def.lights.iter().enumerate() {
             self.light(i, l)?;
+            let place = self.place(l.get_ref().kind.span(), format!("lights[{i}]"));
+            self.origins.lights.push(place);
         }
+        self.origins.camera = self.place(def.camera.span(), "camera".to_string());
         let (camera, rays_per_pixel_edge) = self.camera(&def.camera)?;
         let ambient = match &def.ambient {
             Some(a) => self.color(&at(a, "ambient".into()))?,
@@ -170,6 +179,12 @@ impl Builder<'_> {
             ambient,
             camera,
         };
-        Ok(SceneFile { parts, rays_per_pixel_edge, not_physical: self.not_physical })
+        Ok(SceneFile { parts, origins: self.origins, rays_per_pixel_edge, not_physical: self.not_physical })
+    }
+
+    /// Where the text at `span` is, as a [`super::Place`].
+    fn place(&self, span: Range<usize>, field: String) -> super::Place {
+        let e = self.src.error(span, field, "");
+        super::Place { line: e.line, column: e.column, field: e.field }
     }
 }

@@ -32,10 +32,49 @@ pub struct SceneError {
     pub message: String,
 }
 
+/// Where a part of the scene is written in its file.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Place {
+    pub line: usize,
+    pub column: usize,
+    /// Its path in the scene's structure, e.g. `materials.glass`.
+    pub field: String,
+}
+
+/// The places of a scene file's parts, for what is said of them after the
+/// file has been read (the Mitsuba export's refusals).
+#[derive(Debug, Clone, Default)]
+pub struct Origins {
+    pub path: PathBuf,
+    pub camera: Place,
+    /// Per material of the scene's parts, by index.
+    pub materials: Vec<Place>,
+    /// Per light of the scene's parts, by index (an emissive shape's
+    /// triangles each name the shape).
+    pub lights: Vec<Place>,
+    /// Per object (a `[[shapes]]` entry), by index.
+    pub objects: Vec<Place>,
+}
+
+impl Origins {
+    /// A message about the part written at `place`.
+    pub fn error(&self, place: &Place, message: impl Into<String>) -> SceneError {
+        SceneError {
+            path: self.path.clone(),
+            line: place.line,
+            column: place.column,
+            field: place.field.clone(),
+            message: message.into(),
+        }
+    }
+}
+
 /// A scene read from a file, with what only the Whitted program uses.
 #[derive(Debug, Clone)]
 pub struct SceneFile {
     pub parts: SceneParts,
+    /// Where each part is written.
+    pub origins: Origins,
     /// The n of the n x n jittered samples per pixel.
     pub rays_per_pixel_edge: u32,
     /// Whitted-only features that a physically based renderer cannot

@@ -264,8 +264,10 @@ impl Builder<'_> {
                     Some(_) => Some(self.material_ref(kind, material)?),
                     None => None,
                 };
+                let place = self.origins.objects[i].clone();
                 for t in kept {
                     self.lights.push(LightSpec::Area { surface: Emitting::Triangle(t), radiance, material });
+                    self.origins.lights.push(place.clone());
                 }
             }
             None => {
