@@ -28,6 +28,12 @@ impl Camera {
         Camera { eye, upper_left, across: upper_right - upper_left, down: lower_left - upper_left, width, height }
     }
 
+    /// The image plane: its top-left corner, and the vectors from there to
+    /// the top-right and to the bottom-left corners.
+    pub fn plane(&self) -> (Vertex, Vec3, Vec3) {
+        (self.upper_left, self.across, self.down)
+    }
+
     /// The same view at another resolution.
     pub fn with_resolution(mut self, width: u32, height: u32) -> Self {
         self.width = width;

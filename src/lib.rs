@@ -22,6 +22,7 @@
 pub mod accel;
 pub mod camera;
 pub mod error;
+pub mod export;
 pub mod film;
 pub mod integrator;
 pub mod light;

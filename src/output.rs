@@ -70,6 +70,22 @@ pub fn write_rgb8_image(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> R
     atomically(path, |tmp| encode_rgb8(tmp, width, height, rgb, format))
 }
 
+/// Writes `bytes` to `path` atomically (any file: the exporter's XML and
+/// meshes).
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = parent_dir(path);
+    if !dir.is_dir() {
+        return Err(Error::Io {
+            path: path.to_owned(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                format!("directory {} does not exist", dir.display()),
+            ),
+        });
+    }
+    atomically(path, |tmp| std::fs::write(tmp, bytes).map_err(|e| Error::Io { path: path.to_owned(), source: e }))
+}
+
 /// Runs `write` on a temporary file beside `path`, then renames it over
 /// `path`; the temporary file is removed if anything fails.
 fn atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {

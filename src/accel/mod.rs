@@ -189,7 +189,7 @@ impl Accel {
 mod tests {
     use super::*;
     use crate::sampling::{next_2d, stream, uniform_cone, Domain};
-    use crate::shape::{Sphere, Triangle};
+    use crate::shape::{Departure, Sphere, Triangle};
 
     /// Regression: while no hit bounded the ray, a box the ray misses
     /// (entry distance infinity) passed the test `t <= t_limit` with
@@ -303,6 +303,48 @@ mod tests {
         }
         assert!(checked > 190_000);
         assert!(outside < 2_000, "{outside} rays hit only the polyhedron");
+    }
+
+    /// Rays leaving the room's own faces, to either side (a camera or a
+    /// light outside a closed room sends such rays from the walls' outer
+    /// sides): the enclosure finds what the triangles find. A ray leaving a
+    /// face outwards used to be taken for one inside the room, and met a
+    /// wall it could never reach.
+    #[test]
+    fn rays_leaving_a_face_outwards_meet_nothing_of_the_room() {
+        use crate::math::offset_ray_origin;
+        use crate::scene::{Eye, Scene};
+        let parts = Scene::tncg15_parts(Eye::One);
+        let room: Vec<Shape> = parts.prims[..24].iter().map(|p| p.shape).collect();
+        let group: Vec<Option<u32>> = vec![Some(0); 24];
+        let plain = Accel::new(room.clone());
+        let fast = Accel::with_enclosure(room.clone(), &group);
+        assert!(fast.enclosure().is_some());
+        let mut rng = stream(17, Domain::Camera, 0);
+        let (mut outward, mut inward) = (0, 0);
+        for i in 0..40_000 {
+            let prim = i % 24;
+            let Shape::Triangle(t) = room[prim] else { unreachable!() };
+            let w = next_2d(&mut rng);
+            let (u, v) = if w.x + w.y > 1.0 { (1.0 - w.x, 1.0 - w.y) } else { (w.x, w.y) };
+            let h = t.record(1.0, u, v);
+            let dir = uniform_cone(next_2d(&mut rng), -1.0);
+            let origin = offset_ray_origin(h.point, h.p_err, h.normal, dir);
+            let ray = Ray::new(origin, dir);
+            let dep = Departure { prim: prim as u32, outward: dir.dot(h.normal) > 0.0 };
+            let (a, b) =
+                (plain.closest_hit(&ray, Some(dep), f32::INFINITY), fast.closest_hit(&ray, Some(dep), f32::INFINITY));
+            // Room normals point inwards: leaving against one is leaving the room.
+            if dep.outward {
+                inward += 1;
+                assert!(b.is_some(), "{ray:?} from prim {prim}");
+            } else {
+                outward += 1;
+                assert!(a.is_none() && b.is_none(), "{ray:?} from prim {prim}: {a:?} / {b:?}");
+                assert!(!fast.occluded(&ray, Some(dep), 100.0, None));
+            }
+        }
+        assert!(outward > 15_000 && inward > 15_000);
     }
 
     /// A triangle lying on a face of the enclosure (a rug on the floor)

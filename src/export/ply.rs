@@ -26,10 +26,6 @@ impl PlyMesh {
         self.smooth
     }
 
-    pub fn len(&self) -> usize {
-        self.faces.len()
-    }
-
     pub fn is_empty(&self) -> bool {
         self.faces.is_empty()
     }

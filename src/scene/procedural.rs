@@ -190,6 +190,72 @@ pub fn torus_knot(p: u32, q: u32, major: f32, minor: f32, radius: f32, segments:
     tube(curve, radius, segments, sides)
 }
 
+/// A closed axis-aligned box from `lo` to `hi`, flat (its vertex normals are
+/// its faces').
+pub fn cuboid(lo: Vec3, hi: Vec3) -> Mesh {
+    let mut m = Mesh::default();
+    for axis in 0..3 {
+        for side in [0.0f32, 1.0] {
+            let mut n = Vec3::ZERO;
+            n[axis] = if side > 0.0 { 1.0 } else { -1.0 };
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            let corner = |a: f32, b: f32| {
+                let mut p = Vec3::ZERO;
+                p[axis] = if side > 0.0 { hi[axis] } else { lo[axis] };
+                p[u] = if a > 0.0 { hi[u] } else { lo[u] };
+                p[v] = if b > 0.0 { hi[v] } else { lo[v] };
+                p
+            };
+            let base = m.positions.len() as u32;
+            for (a, b) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+                m.positions.push(corner(a, b));
+                m.normals.push(n);
+            }
+            let mut faces = [[base, base + 1, base + 2], [base, base + 2, base + 3]];
+            let [a, b, c] = faces[0].map(|i| m.positions[i as usize]);
+            if (b - a).cross(c - a).dot(n) < 0.0 {
+                faces = faces.map(|f| [f[0], f[2], f[1]]);
+            }
+            m.faces.extend(faces);
+        }
+    }
+    m
+}
+
+/// The meshes of the scene suite (scenes/suite/), by file name, and
+/// whether each is written flat (no `vn`). The large one is made on demand
+/// (`large`): at ~80 MB it is not kept in the repository.
+pub fn suite_meshes(large: bool) -> Vec<(&'static str, Mesh, bool)> {
+    let mut meshes = vec![
+        ("icosphere-1280.obj", icosphere(3), false),
+        ("icosphere-20k.obj", icosphere(5), false),
+        ("knot-16k.obj", torus_knot(2, 3, 0.8, 0.3, 0.15, 400, 20), false),
+        ("block.obj", cuboid(Vec3::ZERO, Vec3::ONE), true),
+    ];
+    if large {
+        meshes.push(("knot-1m.obj", torus_knot(2, 3, 0.8, 0.3, 0.15, 5000, 100), false));
+    }
+    meshes
+}
+
+/// Writes the suite's meshes into `dir`, those missing only; returns the
+/// names written.
+pub fn write_suite_meshes(dir: &std::path::Path, large: bool) -> std::io::Result<Vec<&'static str>> {
+    std::fs::create_dir_all(dir)?;
+    let mut written = Vec::new();
+    for (name, mesh, flat) in suite_meshes(large) {
+        let path = dir.join(name);
+        if path.exists() {
+            continue;
+        }
+        let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+        std::fs::write(&tmp, mesh.to_obj(flat))?;
+        std::fs::rename(&tmp, &path)?;
+        written.push(name);
+    }
+    Ok(written)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -231,6 +297,18 @@ mod tests {
         let k = torus_knot(2, 3, 1.0, 0.4, 0.15, 300, 16);
         closed_and_outward(&k);
         assert!(k.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-5));
+    }
+
+    #[test]
+    fn cuboid_is_closed_and_flat() {
+        let m = cuboid(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0));
+        assert_eq!(m.faces.len(), 12);
+        let area: f32 = m.triangles().iter().map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length()).sum();
+        assert!((area - 22.0).abs() < 1e-5);
+        for f in &m.faces {
+            let [a, b, c] = f.map(|i| m.positions[i as usize]);
+            assert!((b - a).cross(c - a).normalize().dot(m.normals[f[0] as usize]) > 0.999);
+        }
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! panicked.
 
 mod compare;
+mod export;
 mod render;
 
 use clap::{Parser, Subcommand};
@@ -31,12 +32,15 @@ struct Cli {
 enum Command {
     /// Score an image against a reference (RMSE, relMSE, bias, windows, speckles).
     Compare(compare::Args),
+    /// Write the scene for another renderer (Mitsuba 3).
+    Export(export::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Compare(args)) => compare::run(args),
+        Some(Command::Export(args)) => export::run(args),
         None => render::run(cli.render),
     };
     match result {

@@ -125,6 +125,19 @@ impl Builder<'_> {
                 let t = Triangle::new(v[0], v[1], v[2]);
                 self.triangles(i, &kind, &d.material, emission, &[t], None, &d.vertices)?;
             }
+            "quad" => {
+                self.reject(&kind, &only(&["material", "emission", "vertices"]))?;
+                let v = vertices(4)?;
+                // Planar: the fourth corner on the plane of the first three.
+                let n = (v[1] - v[0]).cross(v[2] - v[0]);
+                let size = (v[2] - v[0]).length().max((v[3] - v[1]).length());
+                if !((v[3] - v[0]).dot(n.normalize_or_zero()).abs() <= 1e-4 * size) {
+                    let span = d.vertices.as_ref().map_or(kind.span.clone(), |v| v.span());
+                    return self.fail(span, &f("vertices"), "the four corners of a quad must lie in one plane");
+                }
+                let quad = [Triangle::new(v[0], v[1], v[2]), Triangle::new(v[0], v[2], v[3])];
+                self.triangles(i, &kind, &d.material, emission, &quad, None, &d.vertices)?;
+            }
             "mesh" => {
                 self.reject(&kind, &only(&["material", "emission", "file", "face_normals", "transform"]))?;
                 let file = self.need(&d.file, &kind, "file")?;
@@ -215,15 +228,13 @@ impl Builder<'_> {
                 }
                 self.prims.extend(tncg15_room(floor, ceiling, walls, i as u32));
             }
-            other => {
-                return self.fail(
-                    kind.span.clone(),
-                    &kind.field,
-                    format!(
-                        "unknown shape type \"{other}\" (triangle, mesh, sphere, ellipsoid, tetrahedron, disk, room)"
-                    ),
-                )
-            }
+            other => return self.fail(
+                kind.span.clone(),
+                &kind.field,
+                format!(
+                    "unknown shape type \"{other}\" (triangle, quad, mesh, sphere, ellipsoid, tetrahedron, disk, room)"
+                ),
+            ),
         }
         Ok(())
     }

@@ -1,0 +1,551 @@
+//! A scene as Mitsuba 3 renders it: XML for the camera, materials, lights
+//! and analytic shapes, binary PLY for the triangle meshes. What has a
+//! faithful equivalent is written; what has none is refused with its place
+//! in the scene file, never approximated silently:
+//!
+//! | photonmap | Mitsuba 3 |
+//! |---|---|
+//! | camera (corners or look-at) | `perspective`, off-centre by `principal_point_offset_x/y`; a plane that is not a rectangle of square pixels, or a mirrored one, is refused |
+//! | triangles, meshes, tetrahedra, the room | `ply` meshes (vertex normals where the mesh is smooth, `face_normals` otherwise) |
+//! | sphere, disk | `sphere`, `disk` (by transform) |
+//! | ellipsoid | `sphere` when the transform scales evenly; else a 20,480-triangle `ply` with exact normals at its vertices (Mitsuba's sphere takes no uneven scale), and a note says so |
+//! | lambertian, mirror | `twosided` `diffuse`, `twosided` `conductor` (photonmap's are two-sided) |
+//! | glass | `dielectric`; absorption as a `homogeneous` interior medium (then `volpath`) |
+//! | disk and triangle lights | `area` emitters (one-sided) on `disk` and `ply` shapes |
+//! | directional and point (1/d^2) lights | `directional`, `point` |
+//! | Phong; point lights of other falloffs | refused |
+//!
+//! The XML takes `spp`, `seed`, `width` and `height` as parameters
+//! (`mi.load_file(path, spp=...)`), defaulting to 64, 0 and the camera's size.
+
+use super::ply::PlyMesh;
+use crate::camera::Camera;
+use crate::light::Emitting;
+use crate::material::Material;
+use crate::math::{Color, Frame};
+use crate::scene::file::{Origins, Place};
+use crate::scene::procedural::icosphere;
+use crate::scene::{LightSpec, SceneParts};
+use crate::shape::{Ellipsoid, Shape, FLAT};
+use glam::{Affine3A, Vec3};
+use std::fmt::Write;
+
+/// An exported scene: the XML text, the mesh files it names (relative
+/// paths and contents), and notes on what was written differently.
+pub struct MitsubaScene {
+    pub xml: String,
+    pub meshes: Vec<(String, Vec<u8>)>,
+    pub notes: Vec<String>,
+}
+
+/// What the export refuses, and where it is written (`None`: the
+/// built-in scene).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Refusal {
+    pub place: Option<Place>,
+    pub message: String,
+}
+
+impl Refusal {
+    /// The refusal as a message, with the file's place where there is one.
+    pub fn describe(&self, origins: Option<&Origins>) -> String {
+        match (&self.place, origins) {
+            (Some(p), Some(o)) => o.error(p, self.message.clone()).to_string(),
+            _ => format!("the built-in scene: {}", self.message),
+        }
+    }
+}
+
+/// Writes `parts` for Mitsuba 3, its meshes named `mesh_dir/NNN.ply`.
+pub fn to_mitsuba(parts: &SceneParts, origins: Option<&Origins>, mesh_dir: &str) -> Result<MitsubaScene, Refusal> {
+    let place = |f: &dyn Fn(&Origins) -> Option<&Place>| origins.and_then(f).cloned();
+    let refuse = |place: Option<Place>, message: String| Refusal { place, message };
+    let mut out = Exporter { mesh_dir, xml: String::new(), meshes: Vec::new(), notes: Vec::new(), media: false };
+    let camera = sensor(&parts.camera).map_err(|m| refuse(place(&|o| Some(&o.camera)), m))?;
+
+    // Materials (those used), each defined once.
+    let mut used = vec![false; parts.materials.len()];
+    for p in &parts.prims {
+        used[p.material as usize] = true;
+    }
+    for l in &parts.lights {
+        if let LightSpec::Area { material: Some(m), .. } = l {
+            used[*m as usize] = true;
+        }
+    }
+    let mut bsdfs = String::new();
+    for (i, m) in parts.materials.iter().enumerate().filter(|(i, _)| used[*i]) {
+        let xml = bsdf(m, &format!("material{i}")).map_err(|msg| refuse(place(&|o| o.materials.get(i)), msg))?;
+        bsdfs += &xml;
+        if let Material::Glass { absorption, .. } = m {
+            if *absorption != Color::ZERO {
+                out.media = true;
+                let _ = writeln!(
+                    bsdfs,
+                    "    <medium type=\"homogeneous\" id=\"medium{i}\">\n        <rgb name=\"sigma_t\" value=\"{}\"/>\n        <rgb name=\"albedo\" value=\"0, 0, 0\"/>\n    </medium>",
+                    rgb(*absorption)
+                );
+            }
+        }
+    }
+    bsdfs += "    <bsdf type=\"diffuse\" id=\"black\"><rgb name=\"reflectance\" value=\"0, 0, 0\"/></bsdf>\n";
+
+    // Geometry: a mesh per run of triangles of one object, material and
+    // shading; analytic shapes one by one.
+    let mut shapes = String::new();
+    let mut run: Option<(u32, u32, PlyMesh)> = None;
+    let refs = |m: u32| material_refs(parts, m);
+    for p in &parts.prims {
+        if let Shape::Triangle(t) = p.shape {
+            let smooth = t.shading != FLAT;
+            let same = run
+                .as_ref()
+                .is_some_and(|(o, m, mesh)| *o == p.object && *m == p.material && mesh.is_smooth() == smooth);
+            if !same {
+                if let Some((_, m, mesh)) = run.take() {
+                    shapes += &out.mesh(mesh, &refs(m), "");
+                }
+                run = Some((p.object, p.material, PlyMesh::new(smooth)));
+            }
+            let normals = if smooth { parts.shading_normals[t.shading as usize] } else { [t.normal; 3] };
+            if let Some((_, _, mesh)) = run.as_mut() {
+                mesh.push([t.v0, t.v1, t.v2], normals);
+            }
+            continue;
+        }
+        if let Some((_, m, mesh)) = run.take() {
+            shapes += &out.mesh(mesh, &refs(m), "");
+        }
+        shapes += &match p.shape {
+            Shape::Sphere(s) => format!(
+                "    <shape type=\"sphere\">\n        <point name=\"center\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{}\"/>\n{}    </shape>\n",
+                xyz(s.center),
+                s.radius,
+                refs(p.material)
+            ),
+            Shape::Disk(d) => format!(
+                "    <shape type=\"disk\">\n        {}\n{}    </shape>\n",
+                disk_transform(d.center, d.normal, d.radius),
+                refs(p.material)
+            ),
+            Shape::Ellipsoid(e) => out.ellipsoid(&e, &refs(p.material)),
+            Shape::Triangle(_) => unreachable!("handled above"),
+        };
+    }
+    if let Some((_, m, mesh)) = run.take() {
+        shapes += &out.mesh(mesh, &refs(m), "");
+    }
+
+    // Lights: area lights are shapes with an emitter (a run of emissive
+    // triangles of one shape is one mesh).
+    let mut emitters = String::new();
+    let mut tri_run: Option<(usize, Color, Option<u32>, PlyMesh)> = None;
+    let flush = |out: &mut Exporter, tri_run: &mut Option<(usize, Color, Option<u32>, PlyMesh)>| {
+        tri_run.take().map_or(String::new(), |(_, radiance, material, mesh)| {
+            let emitter = format!(
+                "        <emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>\n",
+                rgb(radiance)
+            );
+            out.mesh(mesh, &bsdf_ref(material), &emitter)
+        })
+    };
+    for (i, l) in parts.lights.iter().enumerate() {
+        let light_place = || place(&|o| o.lights.get(i));
+        match *l {
+            LightSpec::Area { surface: Emitting::Triangle(t), radiance, material } => {
+                let key = origins.and_then(|o| o.lights.get(i)).map_or(usize::MAX, |p| p.line);
+                let same = tri_run.as_ref().is_some_and(|(k, r, m, _)| *k == key && *r == radiance && *m == material);
+                if !same {
+                    emitters += &flush(&mut out, &mut tri_run);
+                    tri_run = Some((key, radiance, material, PlyMesh::new(false)));
+                }
+                if let Some((_, _, _, mesh)) = tri_run.as_mut() {
+                    mesh.push([t.v0, t.v1, t.v2], [t.normal; 3]);
+                }
+            }
+            LightSpec::Area { surface: Emitting::Disk(d), radiance, material } => {
+                emitters += &flush(&mut out, &mut tri_run);
+                let _ = write!(
+                    emitters,
+                    "    <shape type=\"disk\">\n        {}\n{}        <emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>\n    </shape>\n",
+                    disk_transform(d.center, d.normal, d.radius),
+                    bsdf_ref(material),
+                    rgb(radiance)
+                );
+            }
+            LightSpec::Point { position, intensity, falloff, dead_distance } => {
+                emitters += &flush(&mut out, &mut tri_run);
+                if falloff != 2.0 || dead_distance != 0.0 {
+                    return Err(refuse(
+                        light_place(),
+                        format!(
+                            "a point light dimmed as 1/(d + {dead_distance})^{falloff} has no equivalent in Mitsuba 3 \
+                             (its point lights dim as 1/d^2)"
+                        ),
+                    ));
+                }
+                let _ = write!(
+                    emitters,
+                    "    <emitter type=\"point\">\n        <point name=\"position\" value=\"{}\"/>\n        <rgb name=\"intensity\" value=\"{}\"/>\n    </emitter>\n",
+                    xyz(position),
+                    rgb(intensity)
+                );
+            }
+            LightSpec::Directional { direction, irradiance } => {
+                emitters += &flush(&mut out, &mut tri_run);
+                let _ = write!(
+                    emitters,
+                    "    <emitter type=\"directional\">\n        <vector name=\"direction\" value=\"{}\"/>\n        <rgb name=\"irradiance\" value=\"{}\"/>\n    </emitter>\n",
+                    xyz(direction),
+                    rgb(irradiance)
+                );
+            }
+        }
+    }
+    emitters += &flush(&mut out, &mut tri_run);
+
+    let integrator = if out.media { "volpath" } else { "path" };
+    let (w, h) = (parts.camera.width, parts.camera.height);
+    let mut xml = String::new();
+    let _ = write!(
+        xml,
+        "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!-- Written by photonmap export. Parameters: spp, seed, width, height. -->\n\
+         <scene version=\"3.0.0\">\n    <default name=\"spp\" value=\"64\"/>\n    <default name=\"seed\" value=\"0\"/>\n\
+         \x20   <default name=\"width\" value=\"{w}\"/>\n    <default name=\"height\" value=\"{h}\"/>\n\
+         \x20   <integrator type=\"{integrator}\">\n        <integer name=\"max_depth\" value=\"-1\"/>\n    </integrator>\n\
+         {camera}{bsdfs}{shapes}{emitters}</scene>\n"
+    );
+    out.xml = xml;
+    Ok(MitsubaScene { xml: out.xml, meshes: out.meshes, notes: out.notes })
+}
+
+struct Exporter<'a> {
+    mesh_dir: &'a str,
+    xml: String,
+    meshes: Vec<(String, Vec<u8>)>,
+    notes: Vec<String>,
+    media: bool,
+}
+
+impl Exporter<'_> {
+    /// A `ply` shape of `mesh` with the given references and emitter.
+    fn mesh(&mut self, mesh: PlyMesh, refs: &str, emitter: &str) -> String {
+        if mesh.is_empty() {
+            return String::new();
+        }
+        let name = format!("{}/{:03}.ply", self.mesh_dir, self.meshes.len());
+        let face_normals =
+            if mesh.is_smooth() { "" } else { "        <boolean name=\"face_normals\" value=\"true\"/>\n" };
+        self.meshes.push((name.clone(), mesh.to_bytes()));
+        format!("    <shape type=\"ply\">\n        <string name=\"filename\" value=\"{name}\"/>\n{face_normals}{refs}{emitter}    </shape>\n")
+    }
+
+    /// An ellipsoid: a `sphere` when its transform scales evenly, else a
+    /// tessellation with the ellipsoid's own normals at its vertices.
+    fn ellipsoid(&mut self, e: &Ellipsoid, refs: &str) -> String {
+        let m = e.to_world();
+        let cols = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis];
+        let s = cols[0].length();
+        let even = cols.iter().all(|c| (c.length() - s).abs() <= 1e-5 * s)
+            && (cols[0].dot(cols[1]).abs() + cols[1].dot(cols[2]).abs() + cols[0].dot(cols[2]).abs()) <= 1e-5 * s * s;
+        if even {
+            return format!(
+                "    <shape type=\"sphere\">\n        <point name=\"center\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{s}\"/>\n{refs}    </shape>\n",
+                xyz(Vec3::from(m.translation))
+            );
+        }
+        let normal_map = m.matrix3.inverse().transpose();
+        let sphere = icosphere(5);
+        let mut mesh = PlyMesh::new(true);
+        for f in &sphere.faces {
+            let p = f.map(|i| Vec3::from(m.transform_point3(sphere.positions[i as usize])));
+            let n = f.map(|i| Vec3::from(normal_map * glam::Vec3A::from(sphere.normals[i as usize])).normalize());
+            mesh.push(p, n);
+        }
+        self.notes.push(format!(
+            "an ellipsoid (unevenly scaled sphere) is written as a {}-triangle mesh with its exact normals at the \
+             vertices: Mitsuba 3's sphere takes no uneven scale",
+            sphere.faces.len()
+        ));
+        self.mesh(mesh, refs, "")
+    }
+}
+
+/// References to material `m`'s BSDF and, for absorbing glass, its medium.
+fn material_refs(parts: &SceneParts, m: u32) -> String {
+    let mut s = format!("        <ref id=\"material{m}\"/>\n");
+    if parts.materials[m as usize].absorption().is_some() {
+        s += &format!("        <ref name=\"interior\" id=\"medium{m}\"/>\n");
+    }
+    s
+}
+
+fn bsdf_ref(material: Option<u32>) -> String {
+    match material {
+        Some(m) => format!("        <ref id=\"material{m}\"/>\n"),
+        None => "        <ref id=\"black\"/>\n".to_string(),
+    }
+}
+
+/// A material's BSDF, or why it has none.
+fn bsdf(m: &Material, id: &str) -> Result<String, String> {
+    Ok(match *m {
+        Material::Lambertian { rho } => format!(
+            "    <bsdf type=\"twosided\" id=\"{id}\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"{}\"/></bsdf></bsdf>\n",
+            rgb(rho)
+        ),
+        Material::Mirror { reflectance } => format!(
+            "    <bsdf type=\"twosided\" id=\"{id}\"><bsdf type=\"conductor\"><string name=\"material\" value=\"none\"/><rgb name=\"specular_reflectance\" value=\"{}\"/></bsdf></bsdf>\n",
+            rgb(reflectance)
+        ),
+        Material::Glass { ior, .. } => format!(
+            "    <bsdf type=\"dielectric\" id=\"{id}\"><float name=\"int_ior\" value=\"{ior}\"/><float name=\"ext_ior\" value=\"1\"/></bsdf>\n"
+        ),
+        Material::Phong(_) => {
+            return Err("the Phong material has no equivalent in Mitsuba 3 (its glossy and mirror lobes are \
+                        photonmap's reading of the course's formula); use lambertian, mirror or glass"
+                .into())
+        }
+        Material::Emitter => format!("    <bsdf type=\"diffuse\" id=\"{id}\"><rgb name=\"reflectance\" value=\"0, 0, 0\"/></bsdf>\n"),
+    })
+}
+
+/// The camera as a Mitsuba `perspective` sensor, or why it cannot be one.
+fn sensor(camera: &Camera) -> Result<String, String> {
+    let (upper_left, across, down) = camera.plane();
+    let (w, h) = (camera.width as f32, camera.height as f32);
+    let (la, ld) = (across.length(), down.length());
+    if !(la > 0.0 && ld > 0.0) || across.dot(down).abs() > 1e-4 * la * ld {
+        return Err("the image plane is not a rectangle, which a Mitsuba 3 camera cannot show".into());
+    }
+    if ((la / w) / (ld / h) - 1.0).abs() > 1e-4 {
+        return Err(format!(
+            "its pixels are not square ({:.6} x {:.6} scene units on the image plane at {}x{}); Mitsuba 3's are: \
+             give the image the plane's aspect ratio",
+            la / w,
+            ld / h,
+            camera.width,
+            camera.height
+        ));
+    }
+    let mut forward = across.cross(down).normalize();
+    let mut distance = (upper_left - camera.eye).dot(forward);
+    if distance < 0.0 {
+        forward = -forward;
+        distance = -distance;
+    }
+    if !(distance > 0.0) {
+        return Err("the eye lies in the image plane".into());
+    }
+    let up = -down / ld;
+    // Mitsuba's image runs along forward x up; a plane seen the other way
+    // round is a mirror image, which it cannot show.
+    if forward.cross(up).dot(across) <= 0.0 {
+        return Err("the image plane is seen mirrored from the eye, which a Mitsuba 3 camera cannot show".into());
+    }
+    let foot = camera.eye + distance * forward;
+    let fx = (foot - upper_left).dot(across) / (la * la);
+    let fy = (foot - upper_left).dot(down) / (ld * ld);
+    let fov = 2.0 * (0.5 * la / distance).atan().to_degrees();
+    let mut offsets = String::new();
+    if (fx - 0.5).abs() > 1e-6 {
+        let _ = writeln!(offsets, "        <float name=\"principal_point_offset_x\" value=\"{}\"/>", 0.5 - fx);
+    }
+    if (fy - 0.5).abs() > 1e-6 {
+        let _ = writeln!(offsets, "        <float name=\"principal_point_offset_y\" value=\"{}\"/>", 0.5 - fy);
+    }
+    Ok(format!(
+        "    <sensor type=\"perspective\">\n        <string name=\"fov_axis\" value=\"x\"/>\n        <float name=\"fov\" value=\"{fov}\"/>\n{offsets}\
+         \x20       <float name=\"near_clip\" value=\"{}\"/>\n        <float name=\"far_clip\" value=\"{}\"/>\n\
+         \x20       <transform name=\"to_world\"><lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>\n\
+         \x20       <sampler type=\"independent\"><integer name=\"sample_count\" value=\"$spp\"/><integer name=\"seed\" value=\"$seed\"/></sampler>\n\
+         \x20       <film type=\"hdrfilm\"><integer name=\"width\" value=\"$width\"/><integer name=\"height\" value=\"$height\"/>\
+         <string name=\"pixel_format\" value=\"rgb\"/><string name=\"component_format\" value=\"float32\"/><rfilter type=\"box\"/></film>\n    </sensor>\n",
+        1e-4 * distance,
+        1e7 * distance,
+        xyz(camera.eye),
+        xyz(camera.eye + forward),
+        xyz(up)
+    ))
+}
+
+/// The transform taking Mitsuba's unit disk (normal +z) to a disk.
+fn disk_transform(center: Vec3, normal: Vec3, radius: f32) -> String {
+    let f = Frame::from_normal(normal);
+    let m = Affine3A::from_cols((f.s * radius).into(), (f.t * radius).into(), (f.n * radius).into(), center.into());
+    matrix(&m)
+}
+
+fn matrix(m: &Affine3A) -> String {
+    let c = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis, m.translation];
+    let rows: Vec<String> =
+        (0..3).map(|r| (0..4).map(|k| format!("{}", c[k][r])).collect::<Vec<_>>().join(" ")).collect();
+    format!("<transform name=\"to_world\"><matrix value=\"{} 0 0 0 1\"/></transform>", rows.join(" "))
+}
+
+fn xyz(v: Vec3) -> String {
+    format!("{}, {}, {}", v.x, v.y, v.z)
+}
+
+fn rgb(c: Color) -> String {
+    xyz(c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Eye, Prim, Scene};
+    use crate::shape::Triangle;
+
+    fn triangle(v: [Vec3; 3]) -> Triangle {
+        Triangle::new(v[0], v[1], v[2])
+    }
+
+    fn export(parts: &SceneParts) -> MitsubaScene {
+        to_mitsuba(parts, None, "m").unwrap_or_else(|r| panic!("{}", r.describe(None)))
+    }
+
+    /// The default room: every feature of it has its element.
+    #[test]
+    fn the_default_room_exports_every_part() {
+        let parts = Scene::tncg15_parts(Eye::One);
+        let s = export(&parts);
+        let x = &s.xml;
+        for want in [
+            "type=\"perspective\"",
+            "name=\"fov\" value=\"53.13",
+            "<lookat origin=\"-2, 0, 0\"",
+            "type=\"twosided\"",
+            "type=\"dielectric\"",
+            "name=\"int_ior\" value=\"1.5\"",
+            "type=\"conductor\"",
+            "name=\"specular_reflectance\" value=\"0.95, 0.95, 0.95\"",
+            "type=\"sphere\"",
+            "name=\"radius\" value=\"1.5\"",
+            "type=\"disk\"",
+            "type=\"area\"",
+            "name=\"radiance\" value=\"10, 10, 10\"",
+            "type=\"ply\"",
+            "face_normals",
+            "<integrator type=\"path\">",
+        ] {
+            assert!(x.contains(want), "missing {want}:\n{x}");
+        }
+        assert!(!x.contains("principal_point_offset"), "the room's eye is centred");
+        // The room is one object of seven materials, the tetrahedron one more.
+        assert_eq!(s.meshes.len(), 8);
+        let faces: usize = s
+            .meshes
+            .iter()
+            .map(|(_, b)| {
+                let t = String::from_utf8_lossy(b);
+                t.split("element face ").nth(1).unwrap().split('\n').next().unwrap().parse::<usize>().unwrap()
+            })
+            .sum();
+        assert_eq!(faces, 28);
+    }
+
+    fn parts_with(prims: Vec<Prim>, materials: Vec<Material>, lights: Vec<LightSpec>) -> SceneParts {
+        SceneParts {
+            prims,
+            shading_normals: Vec::new(),
+            materials,
+            lights,
+            ambient: Color::ZERO,
+            camera: Scene::tncg15_parts(Eye::One).camera,
+        }
+    }
+
+    #[test]
+    fn lights_absorption_ellipsoids_and_smooth_meshes() {
+        let t = triangle([Vec3::ZERO, Vec3::X, Vec3::Y]);
+        let mut smooth = t;
+        smooth.shading = 0;
+        let e = Ellipsoid::new(Affine3A::from_scale(Vec3::new(2.0, 1.0, 1.0))).unwrap();
+        let round = Ellipsoid::new(Affine3A::from_scale(Vec3::splat(3.0))).unwrap();
+        let mut parts = parts_with(
+            vec![
+                Prim { shape: Shape::Triangle(smooth), material: 0, object: 0 },
+                Prim { shape: Shape::Ellipsoid(e), material: 0, object: 1 },
+                Prim { shape: Shape::Ellipsoid(round), material: 0, object: 2 },
+            ],
+            vec![Material::Glass { ior: 1.33, absorption: Color::new(0.1, 0.2, 0.3) }],
+            vec![
+                LightSpec::Directional { direction: Vec3::new(0.0, 0.0, -1.0), irradiance: Color::splat(2.0) },
+                LightSpec::Point {
+                    position: Vec3::ONE,
+                    intensity: Color::splat(5.0),
+                    falloff: 2.0,
+                    dead_distance: 0.0,
+                },
+                LightSpec::Area { surface: Emitting::Triangle(t), radiance: Color::splat(3.0), material: None },
+            ],
+        );
+        parts.shading_normals.push([Vec3::Z, Vec3::Z, Vec3::new(0.0, 0.6, 0.8)]);
+        let s = export(&parts);
+        let x = &s.xml;
+        for want in [
+            "<integrator type=\"volpath\">",
+            "type=\"homogeneous\"",
+            "name=\"sigma_t\" value=\"0.1, 0.2, 0.3\"",
+            "<ref name=\"interior\"",
+            "type=\"directional\"",
+            "name=\"irradiance\" value=\"2, 2, 2\"",
+            "type=\"point\"",
+            "name=\"intensity\" value=\"5, 5, 5\"",
+            "<ref id=\"black\"/>",
+        ] {
+            assert!(x.contains(want), "missing {want}:\n{x}");
+        }
+        // The evenly scaled one is a sphere of radius 3.
+        let radius: f32 =
+            x.split("name=\"radius\" value=\"").nth(1).unwrap().split('"').next().unwrap().parse().unwrap();
+        assert!((radius - 3.0).abs() < 1e-5, "{radius}");
+        assert_eq!(s.notes.len(), 1, "{:?}", s.notes);
+        assert!(s
+            .meshes
+            .iter()
+            .any(|(_, b)| String::from_utf8_lossy(&b[..200.min(b.len())]).contains("property float nx")));
+    }
+
+    #[test]
+    fn what_has_no_equivalent_is_refused() {
+        let t = triangle([Vec3::ZERO, Vec3::X, Vec3::Y]);
+        let phong = Material::Phong(crate::material::Phong {
+            color: Color::ONE,
+            ambient: 0.0,
+            diffuse: 0.5,
+            specular: 0.0,
+            metalness: 0.0,
+            shininess: 1.0,
+            mirror: 0.0,
+        });
+        let parts = parts_with(vec![Prim { shape: Shape::Triangle(t), material: 0, object: 0 }], vec![phong], vec![]);
+        let r = to_mitsuba(&parts, None, "m").err().expect("refused");
+        assert!(r.message.contains("Phong"));
+        let falloff = LightSpec::Point { position: Vec3::ONE, intensity: Color::ONE, falloff: 1.0, dead_distance: 0.0 };
+        let parts = parts_with(vec![], vec![], vec![falloff]);
+        assert!(to_mitsuba(&parts, None, "m").err().expect("refused").message.contains("1/d^2"));
+        // Non-square pixels.
+        let mut parts = parts_with(vec![], vec![], vec![]);
+        parts.camera = parts.camera.with_resolution(400, 200);
+        assert!(to_mitsuba(&parts, None, "m").err().expect("refused").message.contains("square"));
+    }
+
+    /// An eye off the plane's centre is kept by the principal point's offset.
+    #[test]
+    fn an_off_centre_eye_is_an_offset_principal_point() {
+        let mut parts = parts_with(vec![], vec![], vec![]);
+        let c = [
+            Vec3::new(0.0, -1.0, -1.0),
+            Vec3::new(0.0, 1.0, -1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+            Vec3::new(0.0, -1.0, 1.0),
+        ];
+        // The eye 0.5 to the right (-y) and 0.25 up of the centre.
+        parts.camera = Camera::from_corners(Vec3::new(-2.0, -0.5, 0.25), c, 100, 100);
+        let x = export(&parts).xml;
+        assert!(x.contains("principal_point_offset_x\" value=\"-0.25\""), "{x}");
+        assert!(x.contains("principal_point_offset_y\" value=\"0.125\""), "{x}");
+    }
+}

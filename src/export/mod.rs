@@ -1,0 +1,5 @@
+//! Scenes written for other renderers, so that photonmap's image can be put
+//! beside theirs on the same scene: Mitsuba 3 ([`mitsuba`]).
+
+pub mod mitsuba;
+mod ply;

@@ -1,0 +1,89 @@
+#!/usr/bin/env python3
+"""An independent reference for a scene: Mitsuba 3's unbiased path tracer on
+the scene as `photonmap export --mitsuba` writes it.
+
+usage: mitsuba_reference.py SCENE.xml OUT.exr --width W --height H --spp N
+                            [--passes P] [--window NAME=R0:R1,C0:C1 ...]
+                            [--variant llvm_ad_rgb] [--seed S]
+
+Renders P passes of N/P samples per pixel (independent seeds), averages them
+in float64 and writes OUT.exr (float32 RGB). Its own noise is estimated by
+splitting the passes into two halves A and B: the RMSE of the full average
+is RMSE(A - B) / 2 (each half has twice the variance of the whole). Writes
+OUT.json beside it: spp, passes, seconds, the Mitsuba version, and that noise
+for the whole image and for each window (rows and columns of OUT.exr,
+half-open). Not a dependency of the project and not run in CI: its outputs
+are committed under tests/data/.
+
+Setup: python3 -m venv V && V/bin/pip install mitsuba==3.9.1 numpy openexr.
+The llvm variant needs libLLVM >= 16: on Debian 12,
+  apt-get download libllvm19 && dpkg-deb -x libllvm19_*.deb llvm19
+  export DRJIT_LIBLLVM_PATH=$PWD/llvm19/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1
+(or --variant scalar_rgb, slower)."""
+import argparse, json, sys, time
+import numpy as np
+
+
+def write_exr(path, img):
+    import OpenEXR
+    img = np.ascontiguousarray(img, dtype=np.float32)
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    chans = {"R": img[..., 0].copy(), "G": img[..., 1].copy(), "B": img[..., 2].copy()}
+    with OpenEXR.File(header, chans) as f:
+        f.write(path)
+
+
+def parse_window(text):
+    name, _, spec = text.rpartition("=")
+    rows, cols = spec.split(",")
+    r0, r1 = (int(v) for v in rows.split(":"))
+    c0, c1 = (int(v) for v in cols.split(":"))
+    return name or "window", (r0, r1, c0, c1)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("scene"); ap.add_argument("out")
+    ap.add_argument("--width", type=int, required=True); ap.add_argument("--height", type=int, required=True)
+    ap.add_argument("--spp", type=int, required=True); ap.add_argument("--passes", type=int, default=16)
+    ap.add_argument("--window", action="append", default=[])
+    ap.add_argument("--variant", default="llvm_ad_rgb"); ap.add_argument("--seed", type=int, default=1000)
+    a = ap.parse_args()
+    import mitsuba as mi
+    mi.set_variant(a.variant)
+    passes = max(2, a.passes - a.passes % 2)
+    per = max(1, a.spp // passes)
+    scene = mi.load_file(a.scene, spp=per, width=a.width, height=a.height)
+    halves = [np.zeros((a.height, a.width, 3)), np.zeros((a.height, a.width, 3))]
+    t0 = time.time()
+    for p in range(passes):
+        img = np.array(mi.render(scene, spp=per, seed=a.seed + p), dtype=np.float64)[..., :3]
+        halves[p % 2] += img
+        print(f"pass {p + 1}/{passes}  {time.time() - t0:.0f} s", file=sys.stderr, flush=True)
+    seconds = time.time() - t0
+    a_half, b_half = (h / (passes // 2) for h in halves)
+    mean = (a_half + b_half) / 2
+    bad = int((~np.isfinite(mean)).sum())
+    write_exr(a.out, mean)
+
+    def noise(r0=0, r1=None, c0=0, c1=None):
+        d = (a_half - b_half)[r0:r1, c0:c1]
+        return float(np.sqrt((d * d).mean()) / 2)
+
+    info = {
+        "scene": a.scene, "width": a.width, "height": a.height, "spp": per * passes, "passes": passes,
+        "seconds": round(seconds, 1), "mitsuba": mi.__version__, "variant": a.variant,
+        "noise_rmse": noise(), "mean": float(mean.mean()), "nonfinite": bad,
+        "windows": {},
+    }
+    for w in a.window:
+        name, (r0, r1, c0, c1) = parse_window(w)
+        info["windows"][name] = {"rows": [r0, r1], "cols": [c0, c1], "noise_rmse": noise(r0, r1, c0, c1),
+                                 "mean": float(mean[r0:r1, c0:c1].mean())}
+    with open(a.out[:-4] + ".json" if a.out.endswith(".exr") else a.out + ".json", "w") as f:
+        json.dump(info, f, indent=1)
+    print(json.dumps(info))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
