@@ -40,3 +40,4 @@ pub mod scene;
 pub mod settings;
 pub mod shape;
 pub mod stats;
+pub mod suite;

@@ -80,6 +80,12 @@ impl Default for Settings {
     }
 }
 
+/// Photons (global and caustic) and camera samples of one pass of a
+/// progressive render, where the user gives neither: many cheap passes
+/// converge faster than few dear ones (notes/progressive.md).
+pub const PROGRESSIVE_PHOTONS: u64 = 250_000;
+pub const PROGRESSIVE_SPP: u32 = 1;
+
 /// The default [`Settings::caustic_reuse`].
 pub const CAUSTIC_REUSE: f32 = 0.1;
 

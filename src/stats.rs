@@ -59,6 +59,9 @@ pub struct Stats {
     pub caustic_stored: usize,
     /// Caustic-pass photons whose first hit was mirror or glass.
     pub caustic_aimed_hits: u64,
+    /// Per caustic target: its object (the scene file's shape index), the
+    /// photons aimed at it, and those whose first hit was mirror or glass.
+    pub caustic_targets: Vec<(u32, u64, u64)>,
     /// Global-pass photons whose first hit was mirror or glass (what the
     /// caustic pass would get without aiming).
     pub global_specular_hits: u64,
@@ -98,6 +101,13 @@ impl Stats {
         self.global_emitted += o.global_emitted;
         self.caustic_emitted += o.caustic_emitted;
         self.caustic_aimed_hits += o.caustic_aimed_hits;
+        if self.caustic_targets.len() < o.caustic_targets.len() {
+            self.caustic_targets = o.caustic_targets.iter().map(|&(object, _, _)| (object, 0, 0)).collect();
+        }
+        for (a, b) in self.caustic_targets.iter_mut().zip(&o.caustic_targets) {
+            a.1 += b.1;
+            a.2 += b.2;
+        }
         self.global_specular_hits += o.global_specular_hits;
         self.photon_rays += o.photon_rays;
         self.camera = self.camera.merge(o.camera);
@@ -162,6 +172,17 @@ impl Summary<'_> {
                 s.caustic_stored,
                 pct(s.caustic_aimed_hits, s.caustic_emitted)
             ));
+            if s.caustic_targets.len() > 1 {
+                for (k, &(object, aimed, hit)) in s.caustic_targets.iter().enumerate().take(8) {
+                    out.push(format!(
+                        "               target {k} (shape {object}): {:.1}% of {aimed} aimed hit mirror/glass",
+                        pct(hit, aimed)
+                    ));
+                }
+                if s.caustic_targets.len() > 8 {
+                    out.push(format!("               ... and {} more targets", s.caustic_targets.len() - 8));
+                }
+            }
             out.push(format!(
                 "               {:.1} MB of maps, {} cache points; radius caps {:.3} global, {:.3} caustic",
                 s.map_bytes as f64 / 1e6,

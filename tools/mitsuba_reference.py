@@ -4,7 +4,7 @@ the scene as `photonmap export --mitsuba` writes it.
 
 usage: mitsuba_reference.py SCENE.xml OUT.exr --width W --height H --spp N
                             [--passes P] [--window NAME=R0:R1,C0:C1 ...]
-                            [--variant llvm_ad_rgb] [--seed S]
+                            [--variant llvm_ad_rgb] [--seed S] [--keep-halves DIR]
 
 Renders P passes of N/P samples per pixel (independent seeds), averages them
 in float64 and writes OUT.exr (float32 RGB). Its own noise is estimated by
@@ -48,6 +48,7 @@ def main():
     ap.add_argument("--spp", type=int, required=True); ap.add_argument("--passes", type=int, default=16)
     ap.add_argument("--window", action="append", default=[])
     ap.add_argument("--variant", default="llvm_ad_rgb"); ap.add_argument("--seed", type=int, default=1000)
+    ap.add_argument("--keep-halves", metavar="DIR", help="also write the two halves' averages there")
     a = ap.parse_args()
     import mitsuba as mi
     mi.set_variant(a.variant)
@@ -65,6 +66,11 @@ def main():
     mean = (a_half + b_half) / 2
     bad = int((~np.isfinite(mean)).sum())
     write_exr(a.out, mean)
+    if a.keep_halves:
+        import os
+        stem = os.path.join(a.keep_halves, os.path.basename(a.out)[:-4])
+        write_exr(stem + ".half-a.exr", a_half)
+        write_exr(stem + ".half-b.exr", b_half)
 
     def noise(r0=0, r1=None, c0=0, c1=None):
         d = (a_half - b_half)[r0:r1, c0:c1]

@@ -11,13 +11,12 @@ use crate::light::Light;
 use crate::material::{Lobe, Transport};
 use crate::math::{max_component, Color, Frame, Ray};
 use crate::sampling::{concentric_disk, next_2d, stream, uniform_cone, uniform_cone_pdf, Domain, Rng};
-use crate::scene::Scene;
+use crate::scene::{Scene, Target};
 use crate::shape::Departure;
 use glam::Vec3;
 use rand::RngExt;
 use rayon::prelude::*;
 use std::f32::consts::PI;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Photons are traced in blocks of this many; each block is one rayon task.
 const BLOCK: u64 = 4096;
@@ -43,6 +42,17 @@ pub struct PassOutput {
     /// Emitted photons whose first hit was a specular object (caustic pass:
     /// the aiming efficiency).
     pub first_hit_specular: u64,
+    /// Caustic pass: per target ([`Scene::specular_targets`]), the photons
+    /// aimed at it and those of them whose first hit was mirror or glass.
+    pub aimed: Vec<[u64; 2]>,
+}
+
+/// What the tracing of a block counted.
+#[derive(Default)]
+struct Tally {
+    rays: u64,
+    first_specular: u64,
+    aimed: Vec<[u64; 2]>,
 }
 
 /// Traces `n` photons of `pass`; `on_block` is told the number of photons
@@ -54,14 +64,12 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
     if n == 0 || !emits || (pass == Pass::Caustic && scene.specular_targets().is_empty()) {
         return PassOutput { emitted: n, ..PassOutput::default() };
     }
-    let rays = AtomicU64::new(0);
-    let first_specular = AtomicU64::new(0);
     let blocks = n.div_ceil(BLOCK);
     let domain = match pass {
         Pass::Global => Domain::GlobalPhotons,
         Pass::Caustic => Domain::CausticPhotons,
     };
-    let per_block: Vec<Vec<Photon>> = (0..blocks)
+    let per_block: Vec<(Vec<Photon>, Tally)> = (0..blocks)
         .into_par_iter()
         // Each thread traces into a buffer that has reached the size of its
         // blocks (a fresh vector per block grew, copied and faulted its way
@@ -69,106 +77,131 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
         // the next block starts in a fresh one of that capacity, whose pages
         // are faulted in only as photons are written.
         .map_init(Vec::new, |out: &mut Vec<Photon>, b| {
-            let (block_rays, block_first) =
-                trace_range::<LANES>(scene, pass, n, seed, domain, b * BLOCK..((b + 1) * BLOCK).min(n), out);
-            rays.fetch_add(block_rays, Ordering::Relaxed);
-            first_specular.fetch_add(block_first, Ordering::Relaxed);
+            let tally = trace_range::<LANES>(scene, pass, n, seed, domain, b * BLOCK..((b + 1) * BLOCK).min(n), out);
             on_block(((b + 1) * BLOCK).min(n) - b * BLOCK);
             let capacity = out.capacity();
-            std::mem::replace(out, Vec::with_capacity(capacity))
+            (std::mem::replace(out, Vec::with_capacity(capacity)), tally)
         })
         .collect();
-    PassOutput {
-        photons: PhotonBlocks::new(per_block),
-        emitted: n,
-        rays: rays.into_inner(),
-        first_hit_specular: first_specular.into_inner(),
+    let mut output =
+        PassOutput { emitted: n, aimed: vec![[0; 2]; scene.specular_targets().len()], ..Default::default() };
+    let mut blocks = Vec::with_capacity(per_block.len());
+    for (photons, tally) in per_block {
+        blocks.push(photons);
+        output.rays += tally.rays;
+        output.first_hit_specular += tally.first_specular;
+        for (total, block) in output.aimed.iter_mut().zip(&tally.aimed) {
+            total[0] += block[0];
+            total[1] += block[1];
+        }
     }
+    output.photons = PhotonBlocks::new(blocks);
+    output
 }
 
+/// A photon leaving its light: its ray, the departure and its power.
+type Emitted = (Ray, Option<Departure>, Color);
+
 /// Picks a light in proportion to its power (one light: always it) and
-/// starts a photon from it. Returns the ray, its departure and its power.
-fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> Option<(Ray, Option<Departure>, Color)> {
-    let (light, p_light) = scene.pick_light(rng.random::<f32>())?;
+/// starts a photon from it; for the caustic pass, also the target it was
+/// aimed at (whether or not the light could send it there).
+fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> (Option<usize>, Option<Emitted>) {
+    let Some((light, p_light)) = scene.pick_light(rng.random::<f32>()) else {
+        return (None, None);
+    };
     let scale = 1.0 / (p_light * n as f32);
     match pass {
         Pass::Global => {
             // The light's natural distribution: each photon carries power / n.
             let (ray, departure) = light.emit(next_2d(rng), next_2d(rng));
-            Some((ray, departure, light.power() * scale))
+            (None, Some((ray, departure, light.power() * scale)))
         }
         Pass::Caustic => {
             let targets = scene.specular_targets();
             let chosen_index = ((rng.random::<f32>() * targets.len() as f32) as usize).min(targets.len() - 1);
             let chosen = &targets[chosen_index];
-            if let Light::Directional { direction, irradiance, reach } = *light {
-                // Parallel light: start uniformly on the disk the chosen
-                // object's bounding sphere casts on the emission plane; the
-                // power is E / (pdf_A n), pdf_A the mixture over all disks.
-                let frame = Frame::from_normal(direction);
-                let project = |c: Vec3| c - direction * (c - reach.0).dot(direction);
-                let d = concentric_disk(next_2d(rng)) * chosen.radius;
-                let origin = project(chosen.center) + frame.s * d.x + frame.t * d.y;
-                let pdf_area: f32 = targets
-                    .iter()
-                    .enumerate()
-                    .map(|(j, t)| {
-                        let inside = (origin - project(t.center)).length_squared() <= t.radius * t.radius;
-                        if j == chosen_index || inside {
-                            1.0 / (PI * t.radius * t.radius)
-                        } else {
-                            0.0
-                        }
-                    })
-                    .sum::<f32>()
-                    / targets.len() as f32;
-                return Some((Ray::new(origin, direction), None, irradiance * scale / pdf_area));
-            }
-            // Direction uniform in the cone of one specular object's bounding
-            // sphere; pdf_w is the mixture over all cones that contain it.
-            let (origin, departure) = match light {
-                Light::Area(a) => (a.sample_point(next_2d(rng)).point, Some(Departure { prim: a.prim, outward: true })),
-                Light::Point { position, .. } => (*position, None),
-                Light::Directional { .. } => unreachable!("handled above"),
-            };
-            let (axis, cos_max) = cone_towards(origin, chosen.center, chosen.radius);
-            // Unit to rounding without normalising (`Frame::to_world`).
-            let dir = Frame::from_normal(axis).to_world(uniform_cone(next_2d(rng), cos_max));
-            // The direction lies in the chosen cone by construction (a test
-            // could deny it by rounding at the rim and leave a zero pdf); the
-            // other cones count where they contain it.
-            let pdf_dir: f32 = targets
-                .iter()
-                .enumerate()
-                .map(|(j, t)| {
-                    if j == chosen_index {
-                        return uniform_cone_pdf(cos_max);
-                    }
-                    let (a, c) = cone_towards(origin, t.center, t.radius);
-                    if dir.dot(a) >= c {
-                        uniform_cone_pdf(c)
-                    } else {
-                        0.0
-                    }
-                })
-                .sum::<f32>()
-                / targets.len() as f32;
-            // Radiant intensity towards `dir`: L cos A for an area light
-            // (sampled by area), I for a point light.
-            let intensity = match light {
-                Light::Area(a) => {
-                    let cos_emit = dir.dot(a.surface.normal());
-                    if !(cos_emit > 0.0) {
-                        return None;
-                    }
-                    a.radiance * cos_emit * a.area()
-                }
-                Light::Point { intensity, .. } => *intensity,
-                Light::Directional { .. } => unreachable!("handled above"),
-            };
-            Some((Ray::new(origin, dir), departure, intensity * scale / pdf_dir))
+            (Some(chosen_index), aim(targets, chosen_index, chosen, light, scale, rng))
         }
     }
+}
+
+/// A caustic photon from `light` towards target `chosen_index`, its power
+/// divided by the pdf of its direction (or, for a directional light, of its
+/// start): the mixture over all targets whose cones (or disks) hold it.
+fn aim(
+    targets: &[Target],
+    chosen_index: usize,
+    chosen: &Target,
+    light: &Light,
+    scale: f32,
+    rng: &mut Rng,
+) -> Option<Emitted> {
+    if let Light::Directional { direction, irradiance, reach } = *light {
+        // Parallel light: start uniformly on the disk the chosen
+        // object's bounding sphere casts on the emission plane; the
+        // power is E / (pdf_A n), pdf_A the mixture over all disks.
+        let frame = Frame::from_normal(direction);
+        let project = |c: Vec3| c - direction * (c - reach.0).dot(direction);
+        let d = concentric_disk(next_2d(rng)) * chosen.radius;
+        let origin = project(chosen.center) + frame.s * d.x + frame.t * d.y;
+        let pdf_area: f32 = targets
+            .iter()
+            .enumerate()
+            .map(|(j, t)| {
+                let inside = (origin - project(t.center)).length_squared() <= t.radius * t.radius;
+                if j == chosen_index || inside {
+                    1.0 / (PI * t.radius * t.radius)
+                } else {
+                    0.0
+                }
+            })
+            .sum::<f32>()
+            / targets.len() as f32;
+        return Some((Ray::new(origin, direction), None, irradiance * scale / pdf_area));
+    }
+    // Direction uniform in the cone of one specular object's bounding
+    // sphere; pdf_w is the mixture over all cones that contain it.
+    let (origin, departure) = match light {
+        Light::Area(a) => (a.sample_point(next_2d(rng)).point, Some(Departure { prim: a.prim, outward: true })),
+        Light::Point { position, .. } => (*position, None),
+        Light::Directional { .. } => unreachable!("handled above"),
+    };
+    let (axis, cos_max) = cone_towards(origin, chosen.center, chosen.radius);
+    // Unit to rounding without normalising (`Frame::to_world`).
+    let dir = Frame::from_normal(axis).to_world(uniform_cone(next_2d(rng), cos_max));
+    // The direction lies in the chosen cone by construction (a test
+    // could deny it by rounding at the rim and leave a zero pdf); the
+    // other cones count where they contain it.
+    let pdf_dir: f32 = targets
+        .iter()
+        .enumerate()
+        .map(|(j, t)| {
+            if j == chosen_index {
+                return uniform_cone_pdf(cos_max);
+            }
+            let (a, c) = cone_towards(origin, t.center, t.radius);
+            if dir.dot(a) >= c {
+                uniform_cone_pdf(c)
+            } else {
+                0.0
+            }
+        })
+        .sum::<f32>()
+        / targets.len() as f32;
+    // Radiant intensity towards `dir`: L cos A for an area light
+    // (sampled by area), I for a point light.
+    let intensity = match light {
+        Light::Area(a) => {
+            let cos_emit = dir.dot(a.surface.normal());
+            if !(cos_emit > 0.0) {
+                return None;
+            }
+            a.radiance * cos_emit * a.area()
+        }
+        Light::Point { intensity, .. } => *intensity,
+        Light::Directional { .. } => unreachable!("handled above"),
+    };
+    Some((Ray::new(origin, dir), departure, intensity * scale / pdf_dir))
 }
 
 /// Axis and cosine of the half-angle of the cone from `from` that just
@@ -189,10 +222,14 @@ struct Path {
     departure: Option<Departure>,
     power: Color,
     rng: Rng,
+    /// The target the photon was aimed at ([`NO_TARGET`]: none).
+    target: u32,
     bounce: u32,
     specular_bounces: u32,
     only_specular_so_far: bool,
 }
+
+const NO_TARGET: u32 = u32::MAX;
 
 /// Photons one thread carries at once. Each segment of a path waits on the
 /// one before it (the hit, then the sampled direction, then the offset
@@ -213,21 +250,25 @@ fn trace_range<const L: usize>(
     domain: Domain,
     range: std::ops::Range<u64>,
     out: &mut Vec<Photon>,
-) -> (u64, u64) {
+) -> Tally {
     let mut next = range.start;
-    let mut rays = 0;
-    let mut first = 0;
+    let mut tally = Tally { aimed: vec![[0; 2]; scene.specular_targets().len()], ..Default::default() };
     // The next photon of the range that leaves its light.
-    let start = |next: &mut u64| -> Option<Path> {
+    let start = |next: &mut u64, tally: &mut Tally| -> Option<Path> {
         while *next < range.end {
             let mut rng = stream(seed, domain, *next);
             *next += 1;
-            if let Some((ray, departure, power)) = emit(scene, pass, n, &mut rng) {
+            let (target, emitted) = emit(scene, pass, n, &mut rng);
+            if let Some(t) = target {
+                tally.aimed[t][0] += 1;
+            }
+            if let Some((ray, departure, power)) = emitted {
                 return Some(Path {
                     ray,
                     departure,
                     power,
                     rng,
+                    target: target.map_or(NO_TARGET, |t| t as u32),
                     bounce: 0,
                     specular_bounces: 0,
                     only_specular_so_far: true,
@@ -236,21 +277,27 @@ fn trace_range<const L: usize>(
         }
         None
     };
-    let mut lanes: [Option<Path>; L] = std::array::from_fn(|_| start(&mut next));
+    let mut lanes: [Option<Path>; L] = std::array::from_fn(|_| start(&mut next, &mut tally));
     loop {
         let mut alive = false;
         for lane in lanes.iter_mut() {
             let Some(path) = lane else { continue };
             alive = true;
-            rays += 1;
+            tally.rays += 1;
+            let target = path.target;
             let (go_on, first_specular) = step(scene, pass, path, out);
-            first += first_specular as u64;
+            if first_specular {
+                tally.first_specular += 1;
+                if let Some(t) = tally.aimed.get_mut(target as usize) {
+                    t[1] += 1;
+                }
+            }
             if !go_on {
-                *lane = start(&mut next);
+                *lane = start(&mut next, &mut tally);
             }
         }
         if !alive {
-            return (rays, first);
+            return tally;
         }
     }
 }
@@ -260,7 +307,7 @@ fn trace_range<const L: usize>(
 /// on, and whether this was the first segment and it hit a specular surface.
 #[inline(always)]
 fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (bool, bool) {
-    let Path { ray, departure, power, rng, bounce, specular_bounces, only_specular_so_far } = path;
+    let Path { ray, departure, power, rng, bounce, specular_bounces, only_specular_so_far, .. } = path;
     let bounce_now = *bounce;
     *bounce += 1;
     let Some(hit) = scene.intersect(ray, *departure) else {

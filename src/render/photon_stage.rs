@@ -79,6 +79,14 @@ pub fn photon_pass(
     stats.global_emitted += global.emitted;
     stats.caustic_emitted += caustic.emitted;
     stats.caustic_aimed_hits += caustic.first_hit_specular;
+    let targets = scene.specular_targets();
+    if stats.caustic_targets.len() < targets.len() {
+        stats.caustic_targets = targets.iter().map(|t| (t.object, 0, 0)).collect();
+    }
+    for (total, aimed) in stats.caustic_targets.iter_mut().zip(&caustic.aimed) {
+        total.1 += aimed[0];
+        total.2 += aimed[1];
+    }
     stats.global_specular_hits += global.first_hit_specular;
     stats.photon_rays += global.rays + caustic.rays;
 

@@ -77,11 +77,16 @@ pub struct Needs {
     pub global: bool,
 }
 
-/// A bounding sphere of a specular object, for aiming caustic photons.
+/// A bounding sphere of an object with a mirror or glass lobe, for aiming
+/// caustic photons: one per object (a mesh of a million triangles is one
+/// target), so that the cost of aiming a photon and the share of photons an
+/// object gets do not grow with its triangles.
 #[derive(Clone, Copy, Debug)]
 pub struct Target {
     pub center: Vertex,
     pub radius: f32,
+    /// The object it bounds.
+    pub object: u32,
 }
 
 pub struct Scene {
@@ -178,6 +183,30 @@ impl SceneParts {
     }
 }
 
+/// One bounding sphere per object with a mirror or glass lobe, in the order
+/// of the objects: centred on the object's box, holding every primitive's
+/// own bounding sphere.
+fn specular_targets(prims: &[Prim], materials: &[Material]) -> Vec<Target> {
+    let mut boxes: std::collections::BTreeMap<u32, (Vec3, Vec3)> = Default::default();
+    let specular = |p: &&Prim| materials[p.material as usize].has_specular_lobe();
+    for p in prims.iter().filter(specular) {
+        let (lo, hi) = p.shape.bounds();
+        let b = boxes.entry(p.object).or_insert((lo, hi));
+        *b = (b.0.min(lo), b.1.max(hi));
+    }
+    let mut targets: std::collections::BTreeMap<u32, Target> = boxes
+        .into_iter()
+        .map(|(object, (lo, hi))| (object, Target { center: 0.5 * (lo + hi), radius: 0.0, object }))
+        .collect();
+    for p in prims.iter().filter(specular) {
+        let (c, r) = p.shape.bounding_sphere();
+        if let Some(t) = targets.get_mut(&p.object) {
+            t.radius = t.radius.max(c.distance(t.center) + r);
+        }
+    }
+    targets.into_values().collect()
+}
+
 impl Scene {
     /// Assembles a scene; the area lights are added as primitives too (after
     /// `parts.prims`, in order), so that camera rays see them and photons are
@@ -233,14 +262,7 @@ impl Scene {
                 *reach = directional_reach(*direction, lo, hi);
             }
         }
-        let targets = prims
-            .iter()
-            .filter(|p| materials[p.material as usize].has_specular_lobe())
-            .map(|p| {
-                let (center, radius) = p.shape.bounding_sphere();
-                Target { center, radius }
-            })
-            .collect();
+        let targets = specular_targets(&prims, &materials);
         // Lights stay out of the enclosure: their hits must name them.
         let group: Vec<Option<u32>> =
             prims.iter().zip(&prim_light).map(|(p, &l)| (l == NO_LIGHT).then_some(p.material)).collect();
@@ -364,7 +386,7 @@ impl Scene {
         (self.bounds.1 - self.bounds.0).length()
     }
 
-    /// Bounding spheres of the primitives with a mirror or glass lobe.
+    /// Bounding spheres of the objects with a mirror or glass lobe.
     pub fn specular_targets(&self) -> &[Target] {
         &self.targets
     }

@@ -27,6 +27,9 @@ enum IntegratorArg {
 /// How 8-bit outputs are made from radiance (`--tonemap`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum ToneMapArg {
+    /// Exposure from the image (its log-average luminance to middle grey),
+    /// then the sRGB curve.
+    Display,
     /// v * 255.99 / i_max, i_max the largest channel value (the course's).
     Linear,
     /// sqrt(v) * 255.99 / sqrt(i_max): for scenes with bright spots.
@@ -136,12 +139,14 @@ pub struct RenderArgs {
     /// nothing.
     #[arg(long)]
     no_skip: bool,
-    /// Tone mapping of 8-bit outputs: linear (255.99 / i_max) or sqrt.
-    #[arg(long, value_enum, default_value_t = ToneMapArg::Linear)]
+    /// How 8-bit outputs (.png, .ppm) are made from radiance: display (an
+    /// exposure from the image, then sRGB), or the course's linear (255.99 /
+    /// i_max) and sqrt mappings, or clamp (1.0 is white). EXR is always
+    /// linear radiance.
+    #[arg(long, value_enum, default_value_t = ToneMapArg::Display)]
     tonemap: ToneMapArg,
-    /// Brightness factor of 8-bit outputs, applied after the tone map's
-    /// normalisation to i_max (values past 255 clip): 4 shows a room that
-    /// the light's own brightness would leave dark.
+    /// Brightness factor of 8-bit outputs, applied on top of the tone map
+    /// (values past white clip).
     #[arg(long, default_value_t = 1.0, value_parser = parse_exposure)]
     exposure: f32,
     /// Score the render against a reference EXR of the default scene (the
@@ -243,6 +248,7 @@ pub fn run(cli: RenderArgs) -> Result<(), Error> {
     let width = cli.width.unwrap_or(scene.camera.width);
     let height = cli.height.unwrap_or(scene.camera.height);
     let tonemap = match cli.tonemap {
+        ToneMapArg::Display => ToneMap::Display,
         ToneMapArg::Linear => ToneMap::Linear,
         ToneMapArg::Sqrt => ToneMap::Sqrt,
         ToneMapArg::Clamp => ToneMap::Clamp,

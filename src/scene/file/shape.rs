@@ -228,13 +228,15 @@ impl Builder<'_> {
                 }
                 self.prims.extend(tncg15_room(floor, ceiling, walls, i as u32));
             }
-            other => return self.fail(
-                kind.span.clone(),
-                &kind.field,
-                format!(
+            other => {
+                return self.fail(
+                    kind.span.clone(),
+                    &kind.field,
+                    format!(
                     "unknown shape type \"{other}\" (triangle, quad, mesh, sphere, ellipsoid, tetrahedron, disk, room)"
                 ),
-            ),
+                )
+            }
         }
         Ok(())
     }

@@ -1,0 +1,332 @@
+//! The scene suite, run and scored: `cargo run --release --example suite`.
+//!
+//! For every scene of scenes/suite/suite.toml: photonmap's default render
+//! (the scene file's camera and size, default settings), timed from
+//! loading the scene to the finished image, and a 60-second progressive
+//! render; each scored against the scene's independent reference (the
+//! reference's own noise subtracted in quadrature). Where Mitsuba 3 is
+//! installed (MITSUBA_PYTHON, a Python with mitsuba 3.9.1; see
+//! tools/mitsuba_reference.py), its path tracer renders the exported scene
+//! for the same wall times and is scored the same way.
+//!
+//! Writes notes/suite.md (the table), notes/suite.csv and one picture per
+//! scene in notes/suite/ (photonmap | reference | signed difference).
+//!
+//! Options: `--only NAME` (repeatable), `--no-mitsuba`, `--no-progressive`,
+//! `--seconds S` (the progressive budget, default 60), `--out DIR` (where
+//! the notes go; default notes/).
+
+use photonmap::film::{Film, ToneMap};
+use photonmap::metrics::{box_down, compare_images, diff_rgb8, Comparison};
+use photonmap::output::{read_exr, write, write_rgb8_image};
+use photonmap::progress::Mode;
+use photonmap::render::{render, render_progressive, Budget};
+use photonmap::scene::Scene;
+use photonmap::settings::{Settings, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP};
+use photonmap::suite::{less_noise, SuiteScene};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+/// One render scored.
+#[derive(Clone)]
+struct Scored {
+    seconds: f64,
+    /// Samples per pixel (Mitsuba) or passes (progressive).
+    count: u64,
+    c: Comparison,
+    rmse: f64,
+    caustic_rmse: f64,
+}
+
+struct Row {
+    name: String,
+    spp: Option<u64>,
+    noise: (Option<f64>, Option<f64>),
+    classic: Scored,
+    progressive: Option<Scored>,
+    mitsuba_classic: Option<Scored>,
+    mitsuba_progressive: Option<Scored>,
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let flag = |f: &str| args.iter().any(|a| a == f);
+    let value = |f: &str| args.windows(2).filter(|w| w[0] == f).map(|w| w[1].clone()).collect::<Vec<_>>();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out_dir = value("--out").first().map(PathBuf::from).unwrap_or_else(|| root.join("notes"));
+    let seconds: f64 = value("--seconds").first().map_or(Ok(60.0), |s| s.parse())?;
+    let only = value("--only");
+    let mitsuba = (!flag("--no-mitsuba")).then(mitsuba_python).flatten();
+    photonmap::scene::procedural::write_suite_meshes(&root.join("scenes/suite/meshes"), true)?;
+    let suite = photonmap::suite::load(&root.join("scenes/suite"))?;
+    let work = std::env::temp_dir().join(format!("photonmap-suite-{}", std::process::id()));
+    std::fs::create_dir_all(&work)?;
+    std::fs::create_dir_all(out_dir.join("suite"))?;
+    let mut rows = Vec::new();
+    for s in suite.iter().filter(|s| only.is_empty() || only.contains(&s.name)) {
+        let reference = s.load_reference()?;
+        let info = s.reference_info();
+        let noise = (info.noise, info.caustic_noise);
+        let score = |film: &Film, seconds: f64, count: u64| -> Result<Scored, String> {
+            let c = compare_images(film, &reference, std::slice::from_ref(&s.caustic)).map_err(|e| e.to_string())?;
+            let (rmse, caustic_rmse) = (less_noise(c.whole.rmse, noise.0), less_noise(c.windows[0].1.rmse, noise.1));
+            Ok(Scored { seconds, count, c, rmse, caustic_rmse })
+        };
+        // The default command: load, render.
+        let t = Instant::now();
+        let file = photonmap::scene::file::load(&s.scene)?;
+        let n = file.rays_per_pixel_edge;
+        let scene = Scene::from_parts(file.parts);
+        let settings =
+            Settings { spp: n * n, width: scene.camera.width, height: scene.camera.height, ..Settings::default() };
+        let (film, _) = render(&scene, &settings, Mode::Quiet);
+        let classic = score(&film, t.elapsed().as_secs_f64(), 1)?;
+        write(&work.join(format!("{}.exr", s.name)), &film, ToneMap::Display, 1.0)?;
+        eprintln!(
+            "{:<16} default     {:>7.1} s  rmse {:.5}  caustic {:.5}",
+            s.name, classic.seconds, classic.rmse, classic.caustic_rmse
+        );
+        picture(&out_dir.join("suite").join(format!("{}.png", s.name)), &film, &reference, classic.c.factor)?;
+        let progressive = if flag("--no-progressive") {
+            None
+        } else {
+            let t = Instant::now();
+            let p = Settings {
+                photons: PROGRESSIVE_PHOTONS,
+                caustic_photons: PROGRESSIVE_PHOTONS,
+                spp: PROGRESSIVE_SPP,
+                ..settings
+            };
+            let load = std::time::Duration::ZERO;
+            let (film, stats) = render_progressive(&scene, &p, Budget::Seconds(seconds - load.as_secs_f64()), |_| {});
+            let scored = score(&film, t.elapsed().as_secs_f64(), stats.passes as u64)?;
+            eprintln!(
+                "{:<16} progressive {:>7.1} s  rmse {:.5}  caustic {:.5}  ({} passes)",
+                s.name, scored.seconds, scored.rmse, scored.caustic_rmse, stats.passes
+            );
+            Some(scored)
+        };
+        let (mut mitsuba_classic, mut mitsuba_progressive) = (None, None);
+        if let Some(py) = &mitsuba {
+            let xml = work.join(format!("{}.xml", s.name));
+            let file = photonmap::scene::file::load(&s.scene)?;
+            let mesh_dir = format!("{}-meshes", s.name);
+            let exported = photonmap::export::mitsuba::to_mitsuba(&file.parts, Some(&file.origins), &mesh_dir)
+                .map_err(|r| r.describe(Some(&file.origins)))?;
+            std::fs::create_dir_all(work.join(&mesh_dir))?;
+            for (name, bytes) in &exported.meshes {
+                std::fs::write(work.join(name), bytes)?;
+            }
+            std::fs::write(&xml, &exported.xml)?;
+            let mut budgets = vec![(classic.seconds, &mut mitsuba_classic)];
+            if let Some(p) = &progressive {
+                budgets.push((p.seconds, &mut mitsuba_progressive));
+            }
+            for (budget, slot) in budgets {
+                let exr = work.join(format!("{}-mitsuba-{budget:.0}.exr", s.name));
+                let (w, h) = (scene.camera.width.to_string(), scene.camera.height.to_string());
+                let o = Command::new(py)
+                    .arg(root.join("tools/mitsuba_equal_time.py"))
+                    .arg(&xml)
+                    .arg(format!("{budget}"))
+                    .arg(&exr)
+                    .args(["--width", &w, "--height", &h])
+                    .output()?;
+                if !o.status.success() {
+                    return Err(format!("Mitsuba on {}: {}", s.name, String::from_utf8_lossy(&o.stderr)).into());
+                }
+                let v: serde_json::Value = serde_json::from_slice(&o.stdout)?;
+                let scored =
+                    score(&read_exr(&exr)?, v["seconds"].as_f64().unwrap_or(budget), v["spp"].as_u64().unwrap_or(0))?;
+                eprintln!(
+                    "{:<16} mitsuba     {:>7.1} s  rmse {:.5}  caustic {:.5}  ({} spp)",
+                    s.name, scored.seconds, scored.rmse, scored.caustic_rmse, scored.count
+                );
+                *slot = Some(scored);
+            }
+        }
+        rows.push(Row {
+            name: s.name.clone(),
+            spp: info.spp,
+            noise,
+            classic,
+            progressive,
+            mitsuba_classic,
+            mitsuba_progressive,
+        });
+    }
+    let _ = std::fs::remove_dir_all(&work);
+    std::fs::write(out_dir.join("suite.md"), report(&rows, &suite, seconds))?;
+    std::fs::write(out_dir.join("suite.csv"), csv(&rows))?;
+    eprintln!("wrote {}", out_dir.join("suite.md").display());
+    Ok(())
+}
+
+/// A Python that imports mitsuba: MITSUBA_PYTHON, else python3.
+fn mitsuba_python() -> Option<PathBuf> {
+    let py = std::env::var_os("MITSUBA_PYTHON").map(PathBuf::from).unwrap_or_else(|| "python3".into());
+    let ok = Command::new(&py).args(["-c", "import mitsuba"]).output().is_ok_and(|o| o.status.success());
+    ok.then_some(py)
+}
+
+/// photonmap (reduced to the reference's size) | reference | signed
+/// difference, side by side; both images under the reference's exposure.
+fn picture(path: &Path, film: &Film, reference: &Film, factor: u32) -> Result<(), Box<dyn std::error::Error>> {
+    let down = box_down(film, factor);
+    let (w, h) = (reference.width, reference.height);
+    let scale = reference.display_scale();
+    let shown = |f: &Film| Film {
+        width: w,
+        height: h,
+        pixels: f.pixels.iter().map(|c| *c * (scale / f.display_scale())).collect(),
+    };
+    let a = shown(&down).to_rgb8(ToneMap::Display, 1.0);
+    let b = reference.to_rgb8(ToneMap::Display, 1.0);
+    let (d, _) = diff_rgb8(&down, reference, None);
+    let gap = 4;
+    let total = 3 * w + 2 * gap;
+    let mut rgb = vec![255u8; (total * h * 3) as usize];
+    for (k, img) in [a, b, d].iter().enumerate() {
+        for y in 0..h {
+            for x in 0..w {
+                let src = ((y * w + x) * 3) as usize;
+                let dst = ((y * total + k as u32 * (w + gap) + x) * 3) as usize;
+                rgb[dst..dst + 3].copy_from_slice(&img[src..src + 3]);
+            }
+        }
+    }
+    write_rgb8_image(path, total, h, rgb)?;
+    Ok(())
+}
+
+fn ratio(peer: Option<&Scored>, ours: f64, pick: impl Fn(&Scored) -> f64) -> String {
+    match peer {
+        Some(p) if ours > 0.0 => format!("{:.1}x", pick(p) / ours),
+        _ => "—".into(),
+    }
+}
+
+fn report(rows: &[Row], suite: &[SuiteScene], seconds: f64) -> String {
+    let commit = Command::new("git")
+        .args(["rev-parse", "--short", "HEAD"])
+        .output()
+        .ok()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_default();
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let threads = rayon::current_num_threads();
+    let mut s = String::new();
+    let _ = writeln!(s, "# The scene suite\n");
+    let _ = writeln!(
+        s,
+        "`cargo run --release --example suite` at commit {commit}, on {cpu} ({threads} threads). Every scene is \
+         scored against its independent reference (Mitsuba 3's path tracer on the exported scene, 200 x 200; \
+         tests/data/suite/), with the metric of `photonmap compare`: RMSE over the whole image and the caustic \
+         window (scenes/suite/suite.toml), each less the reference's own noise in quadrature; bias is the mean's \
+         relative difference. *Default*: photonmap's default settings, timed from loading the scene to the \
+         finished image. *Progressive*: {seconds:.0} s of progressive passes ({} photons and {} spp a pass). \
+         *Mitsuba*: its path tracer at the same wall time, loading included; *ratio*: Mitsuba's error over \
+         photonmap's.\n",
+        PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP
+    );
+    let _ = writeln!(s, "| scene | ref spp | ref noise (whole / caustic) | default: time | bias | caustic bias | RMSE | caustic RMSE | speckles | Mitsuba RMSE / caustic (spp) | ratio | caustic ratio |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for r in rows {
+        let c = &r.classic;
+        let m = r.mitsuba_classic.as_ref();
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} / {} | {:.1} s | {:+.2}% | {:+.2}% | {:.5} | {:.4} | {} | {} | {} | {} |",
+            r.name,
+            r.spp.map_or("—".into(), |v| v.to_string()),
+            r.noise.0.map_or("—".into(), |v| format!("{v:.5}")),
+            r.noise.1.map_or("—".into(), |v| format!("{v:.4}")),
+            c.seconds,
+            100.0 * c.c.whole.bias(),
+            100.0 * c.c.windows[0].1.bias(),
+            c.rmse,
+            c.caustic_rmse,
+            c.c.speckles,
+            m.map_or("—".into(), |m| format!("{:.5} / {:.4} ({})", m.rmse, m.caustic_rmse, m.count)),
+            ratio(m, c.rmse, |p| p.rmse),
+            ratio(m, c.caustic_rmse, |p| p.caustic_rmse),
+        );
+    }
+    if rows.iter().any(|r| r.progressive.is_some()) {
+        let _ = writeln!(s, "\n| scene | progressive: time (passes) | bias | caustic bias | RMSE | caustic RMSE | Mitsuba RMSE / caustic (spp) | ratio | caustic ratio |");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
+        for r in rows {
+            let Some(p) = &r.progressive else { continue };
+            let m = r.mitsuba_progressive.as_ref();
+            let _ = writeln!(
+                s,
+                "| {} | {:.1} s ({}) | {:+.2}% | {:+.2}% | {:.5} | {:.4} | {} | {} | {} |",
+                r.name,
+                p.seconds,
+                p.count,
+                100.0 * p.c.whole.bias(),
+                100.0 * p.c.windows[0].1.bias(),
+                p.rmse,
+                p.caustic_rmse,
+                m.map_or("—".into(), |m| format!("{:.5} / {:.4} ({})", m.rmse, m.caustic_rmse, m.count)),
+                ratio(m, p.rmse, |q| q.rmse),
+                ratio(m, p.caustic_rmse, |q| q.caustic_rmse),
+            );
+        }
+    }
+    let _ = writeln!(s, "\n## The scenes\n\nEach picture: photonmap's default render (reduced to 200 x 200) | the reference | the signed difference (red: photonmap brighter, blue: darker).\n");
+    for r in rows {
+        let comment = suite
+            .iter()
+            .find(|x| x.name == r.name)
+            .and_then(|x| std::fs::read_to_string(&x.scene).ok())
+            .map(|t| {
+                t.lines()
+                    .take_while(|l| l.starts_with('#'))
+                    .map(|l| l.trim_start_matches('#').trim())
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            })
+            .unwrap_or_default();
+        let _ = writeln!(s, "### {}\n\n{comment}\n\n![{}](suite/{}.png)\n", r.name, r.name, r.name);
+    }
+    s
+}
+
+fn csv(rows: &[Row]) -> String {
+    let mut s = String::from("scene,run,seconds,count,bias,caustic_bias,rmse,caustic_rmse,speckles\n");
+    for r in rows {
+        let runs = [
+            ("default", Some(&r.classic)),
+            ("progressive", r.progressive.as_ref()),
+            ("mitsuba_default", r.mitsuba_classic.as_ref()),
+            ("mitsuba_progressive", r.mitsuba_progressive.as_ref()),
+        ];
+        for (run, x) in runs {
+            if let Some(x) = x {
+                let _ = writeln!(
+                    s,
+                    "{},{run},{:.2},{},{:.5},{:.5},{:.6},{:.6},{}",
+                    r.name,
+                    x.seconds,
+                    x.count,
+                    x.c.whole.bias(),
+                    x.c.windows[0].1.bias(),
+                    x.rmse,
+                    x.caustic_rmse,
+                    x.c.speckles
+                );
+            }
+        }
+    }
+    s
+}

@@ -1,0 +1,101 @@
+//! The scene suite (scenes/suite/): the scenes every change is scored on,
+//! each with its independent reference and the window that frames its
+//! caustic, as `scenes/suite/suite.toml` lists them. The suite's runner
+//! (`examples/suite.rs`) and its tests (`tests/suite.rs`) read it here.
+
+use crate::film::Film;
+use crate::metrics::Window;
+use crate::output::read_exr;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Manifest {
+    scene: Vec<EntryDef>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EntryDef {
+    file: String,
+    reference: String,
+    caustic: WindowDef,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct WindowDef {
+    rows: [u32; 2],
+    cols: [u32; 2],
+}
+
+/// One scene of the suite.
+#[derive(Clone, Debug)]
+pub struct SuiteScene {
+    /// The scene file's stem, e.g. `02-cornell`.
+    pub name: String,
+    pub scene: PathBuf,
+    pub reference: PathBuf,
+    /// The caustic window, in the reference's pixels.
+    pub caustic: Window,
+}
+
+/// The reference's own noise and how it was made, from the JSON beside it
+/// (absent for references that come with none).
+#[derive(Clone, Debug, Default)]
+pub struct ReferenceInfo {
+    pub spp: Option<u64>,
+    /// Estimated RMSE of the reference itself, whole image and caustic window.
+    pub noise: Option<f64>,
+    pub caustic_noise: Option<f64>,
+}
+
+impl SuiteScene {
+    pub fn load_reference(&self) -> Result<Film, String> {
+        read_exr(&self.reference).map_err(|e| e.to_string())
+    }
+
+    pub fn reference_info(&self) -> ReferenceInfo {
+        let json = self.reference.with_extension("json");
+        let Ok(text) = std::fs::read_to_string(&json) else {
+            return ReferenceInfo::default();
+        };
+        let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else {
+            return ReferenceInfo::default();
+        };
+        ReferenceInfo {
+            spp: v["spp"].as_u64(),
+            noise: v["noise_rmse"].as_f64(),
+            caustic_noise: v["windows"]["caustic"]["noise_rmse"].as_f64(),
+        }
+    }
+}
+
+/// The suite in `dir` (scenes/suite), in the manifest's order.
+pub fn load(dir: &Path) -> Result<Vec<SuiteScene>, String> {
+    let path = dir.join("suite.toml");
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let m: Manifest = toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(m.scene
+        .into_iter()
+        .map(|e| SuiteScene {
+            name: e.file.trim_end_matches(".toml").to_string(),
+            scene: dir.join(&e.file),
+            reference: dir.join(&e.reference),
+            caustic: Window {
+                name: "caustic".into(),
+                rows: (e.caustic.rows[0], e.caustic.rows[1]),
+                cols: (e.caustic.cols[0], e.caustic.cols[1]),
+            },
+        })
+        .collect())
+}
+
+/// An error measured against a noisy reference, less the reference's own
+/// noise in quadrature (the two are independent); zero where the noise
+/// accounts for all of it.
+pub fn less_noise(measured: f64, noise: Option<f64>) -> f64 {
+    let n = noise.unwrap_or(0.0);
+    (measured * measured - n * n).max(0.0).sqrt()
+}

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Renders the independent references of the scene suite (scenes/suite/):
+# each scene exported by `photonmap export --mitsuba` and rendered by
+# Mitsuba 3's path tracer at 200 x 200 (tools/mitsuba_reference.py), into
+# tests/data/suite/NAME.exr with NAME.json (spp, time, its own noise).
+# Scene 1 is the default room, whose reference ships in tests/data/.
+#
+# usage: tools/suite_references.sh [SPP] [NAME ...]     (default 8192, all)
+# Needs Mitsuba 3.9.1 in a Python (MITSUBA_PYTHON, default python3) and, for
+# the llvm variant, DRJIT_LIBLLVM_PATH (see tools/mitsuba_reference.py).
+# Hours of CPU: run it by hand, not in CI.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+spp=${1:-8192}
+shift || true
+py=${MITSUBA_PYTHON:-python3}
+cargo build --release --bin photonmap -q
+cargo run --release --example suite_meshes -q -- --large
+out=tests/data/suite
+work=$(mktemp -d)
+mkdir -p "$out"
+# name and caustic window (rows, columns of the 200 x 200 reference)
+scenes=(
+  "02-cornell caustic=171:190,39:83"
+  "03-knot caustic=100:141,94:135"
+  "04-small-light caustic=176:192,130:154"
+  "05-sun-window caustic=96:130,100:156"
+  "06-water-glass caustic=115:156,95:175"
+  "07-million caustic=100:141,94:135"
+  "08-hall caustic=96:128,72:128"
+)
+for entry in "${scenes[@]}"; do
+  read -r name window <<<"$entry"
+  if [ $# -gt 0 ] && [[ ! " $* " == *" $name "* ]]; then continue; fi
+  ./target/release/photonmap export --mitsuba "scenes/suite/$name.toml" "$work/$name.xml"
+  "$py" tools/mitsuba_reference.py "$work/$name.xml" "$out/$name.exr" --width 200 --height 200 \
+    --spp "$spp" --passes 16 --window "$window" --keep-halves "$work"
+done
+echo "halves kept in $work"
