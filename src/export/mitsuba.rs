@@ -258,7 +258,7 @@ impl Exporter<'_> {
         let sphere = icosphere(5);
         let mut mesh = PlyMesh::new(true);
         for f in &sphere.faces {
-            let p = f.map(|i| Vec3::from(m.transform_point3(sphere.positions[i as usize])));
+            let p = f.map(|i| m.transform_point3(sphere.positions[i as usize]));
             let n = f.map(|i| Vec3::from(normal_map * glam::Vec3A::from(sphere.normals[i as usize])).normalize());
             mesh.push(p, n);
         }

@@ -48,7 +48,7 @@ pub struct PassOutput {
 }
 
 /// What the tracing of a block counted.
-#[derive(Default)]
+#[derive(Debug, Default, PartialEq)]
 struct Tally {
     rays: u64,
     first_specular: u64,
