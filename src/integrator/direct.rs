@@ -38,7 +38,10 @@ pub fn direct_light(
             let mut pair = [None; 2];
             for (j, slot) in pair.iter_mut().enumerate().take((count - s) as usize) {
                 let u = stratified_2d(s + j as u32, count, next_2d(ctx.rng));
-                *slot = light.incident(hit.point, u).map(|inc| (n.dot(inc.dir), inc)).filter(|&(c, _)| c > 0.0);
+                *slot = light
+                    .incident(hit.point, u)
+                    .map(|inc| (n.dot(inc.dir), inc))
+                    .filter(|&(c, inc)| c > 0.0 && reaches(hit, n, inc.dir));
             }
             for (cos_x, inc) in pair.into_iter().flatten() {
                 if unshadowed(scene, hit, &inc, ctx) {
@@ -66,7 +69,7 @@ pub fn direct_light_one_at_a_time(
             let u = stratified_2d(s, count, next_2d(ctx.rng));
             let Some(inc) = light.incident(hit.point, u) else { continue };
             let cos_x = n.dot(inc.dir);
-            if cos_x > 0.0 && unshadowed(scene, hit, &inc, ctx) {
+            if cos_x > 0.0 && reaches(hit, n, inc.dir) && unshadowed(scene, hit, &inc, ctx) {
                 sum += brdf(inc.dir) * inc.intensity * cos_x;
             }
         }
@@ -94,6 +97,14 @@ fn each_light(
         sum += per_light(light, count, ctx) / count.max(1) as f32;
     }
     sum
+}
+
+/// Whether light from `dir` can reach the surface's side `n` faces: above
+/// the shading normal is not enough where it differs from the geometric
+/// one (light from below the actual surface would leak through it).
+#[inline]
+fn reaches(hit: &Hit, n: Vec3, dir: Vec3) -> bool {
+    hit.shading_normal == hit.normal || hit.leaves_as(-n, dir, true)
 }
 
 /// Casts the shadow ray from `hit` towards a light sample: whether nothing

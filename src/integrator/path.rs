@@ -10,7 +10,7 @@
 
 use super::{direct_light, Context, Integrator, Part};
 use crate::material::{Lobe, Scatter, Transport};
-use crate::math::{max_component, Color, Frame, Ray};
+use crate::math::{max_component, Color, Ray};
 use crate::scene::Scene;
 use rand::RngExt;
 
@@ -57,10 +57,9 @@ impl Integrator for PathIntegrator<'_> {
             if material.is_emitter() {
                 break;
             }
-            let n = hit.facing_normal(ray.dir);
-            let frame = Frame::from_normal(n);
+            let (frame, entering) = hit.scattering_frame(ray.dir, material);
+            let n = frame.n;
             let wo = frame.to_local(-ray.dir);
-            let entering = ray.dir.dot(hit.normal) < 0.0;
             let scatter = if part == Part::Emitted {
                 // Only a specular lobe continues a specular chain.
                 let Some(b) = material.specular_branches(wo, entering, Transport::Radiance).choose(ctx.rng) else {
@@ -76,6 +75,10 @@ impl Integrator for PathIntegrator<'_> {
                 let Some(s) = material.sample(wo, entering, Transport::Radiance, ctx.rng) else { break };
                 s
             };
+            let dir = frame.to_world(scatter.wi).normalize();
+            if hit.shading_normal != hit.normal && !hit.leaves_as(ray.dir, dir, scatter.wi.z > 0.0) {
+                break;
+            }
             if scatter.lobe == Lobe::Specular {
                 count_emission = true;
             } else {
@@ -93,7 +96,7 @@ impl Integrator for PathIntegrator<'_> {
             if max_component(throughput) <= 0.0 {
                 break;
             }
-            let (next, dep) = hit.spawn(frame.to_world(scatter.wi).normalize());
+            let (next, dep) = hit.spawn(dir);
             (ray, departure) = (next, Some(dep));
         }
         radiance

@@ -169,10 +169,8 @@ impl PhotonIntegrator<'_> {
         if material.is_emitter() {
             return through * emitted;
         }
-        let n = hit.facing_normal(ray.dir);
-        let frame = Frame::from_normal(n);
+        let (frame, entering) = hit.scattering_frame(ray.dir, material);
         let wo = frame.to_local(-ray.dir);
-        let entering = ray.dir.dot(hit.normal) < 0.0;
         let branches = material.specular_branches(wo, entering, Transport::Radiance);
         let mut radiance = emitted;
         if !branches.is_empty() {
@@ -236,8 +234,11 @@ impl PhotonIntegrator<'_> {
         if let Some(p) = material.glossy() {
             // One gather ray from the glossy lobe: indirect light it reflects.
             if let Some((wi, weight)) = p.sample_glossy(wo, next_2d(sh.ctx.rng)) {
-                let (next, dep) = hit.spawn(frame.to_world(wi).normalize());
-                indirect += weight * self.gather(next, dep, w * weight, sh);
+                let dir = frame.to_world(wi).normalize();
+                if hit.leaves_as(-frame.n, dir, true) {
+                    let (next, dep) = hit.spawn(dir);
+                    indirect += weight * self.gather(next, dep, w * weight, sh);
+                }
             }
         }
         self.checked(direct, "direct", sh)
@@ -283,6 +284,11 @@ impl PhotonIntegrator<'_> {
         let mut sum = Color::ZERO;
         for g in 0..count {
             let dir = frame.to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(sh.ctx.rng)))).normalize();
+            // About a shading normal a gather ray may point into the
+            // surface: it gathers nothing.
+            if hit.shading_normal != hit.normal && !hit.leaves_as(-n, dir, true) {
+                continue;
+            }
             let (ray, dep) = hit.spawn(dir);
             let h = self.gather_hit(ray, dep, sh);
             sum += self.read(&h, w, sh);
@@ -337,13 +343,12 @@ impl PhotonIntegrator<'_> {
             };
             weight *= self.scene.transmittance(Some(dep), y.t);
             let material = self.scene.material(y.prim);
+            let (frame, entering) = y.scattering_frame(ray.dir, material);
             if let Some(rho_y) = material.diffuse_rho() {
                 // A Phong surface's mirror lobe is not followed here: its
                 // share of indirect light is left out (notes/scene-format.md).
-                return GatherHit { point: y.point, normal: y.facing_normal(ray.dir), weight: weight * rho_y / PI };
+                return GatherHit { point: y.point, normal: frame.n, weight: weight * rho_y / PI };
             }
-            let frame = Frame::from_normal(y.facing_normal(ray.dir));
-            let entering = ray.dir.dot(y.normal) < 0.0;
             let branches = material.specular_branches(frame.to_local(-ray.dir), entering, Transport::Radiance);
             let Some(b) = branches.choose(sh.ctx.rng) else { break };
             weight *= b.scale;

@@ -15,6 +15,7 @@
 use crate::film::Film;
 use crate::material::{Material, Phong, Transport};
 use crate::math::{max_component, Color, Frame, Ray};
+use crate::optics::reflect;
 use crate::progress::Mode;
 use crate::render::{camera_pass, CameraPass};
 use crate::sampling::{next_2d, stratified_2d, Rng};
@@ -41,9 +42,10 @@ impl Whitted<'_> {
         };
         let through = self.scene.transmittance(departure, hit.t);
         let material = self.scene.material(hit.prim);
+        let (frame, entering) = hit.scattering_frame(ray.dir, material);
         let shaded = match material.course_phong() {
-            Some(p) => self.phong(&hit, ray, &p, depth, rng),
-            None => self.specular(&hit, ray, material, depth, rng),
+            Some(p) => self.phong(&hit, ray, &frame, &p, depth, rng),
+            None => self.specular(&hit, ray, &frame, entering, material, depth, rng),
         };
         // A light's own surface, or a glowing one.
         through * (self.scene.emitted(hit.prim, ray.dir) + shaded)
@@ -51,12 +53,20 @@ impl Whitted<'_> {
 
     /// Mirrors and glass: every branch (Fresnel's shares for glass) traced
     /// on, to the depth limit.
-    fn specular(&self, hit: &Hit, ray: &Ray, material: &Material, depth: u32, rng: &mut Rng) -> Color {
+    #[allow(clippy::too_many_arguments)]
+    fn specular(
+        &self,
+        hit: &Hit,
+        ray: &Ray,
+        frame: &Frame,
+        entering: bool,
+        material: &Material,
+        depth: u32,
+        rng: &mut Rng,
+    ) -> Color {
         if depth >= self.max_depth {
             return Color::ZERO;
         }
-        let frame = Frame::from_normal(hit.facing_normal(ray.dir));
-        let entering = ray.dir.dot(hit.normal) < 0.0;
         let mut c = Color::ZERO;
         for b in material.specular_branches(frame.to_local(-ray.dir), entering, Transport::Radiance).iter() {
             let (next, dep) = hit.spawn(frame.to_world(b.wi).normalize());
@@ -66,16 +76,16 @@ impl Whitted<'_> {
     }
 
     /// The bounce ray: `ray` reflected about the normal, if depth allows.
-    fn bounce(&self, hit: &Hit, ray: &Ray, depth: u32, rng: &mut Rng) -> Color {
+    fn bounce(&self, hit: &Hit, ray: &Ray, frame: &Frame, depth: u32, rng: &mut Rng) -> Color {
         if depth >= self.max_depth {
             return Color::ZERO;
         }
-        let (next, dep) = hit.spawn(hit.mirrored(ray.dir));
+        let (next, dep) = hit.spawn(frame.to_world(reflect(frame.to_local(-ray.dir))).normalize());
         self.trace_ray(&next, Some(dep), depth + 1, rng)
     }
 
-    fn phong(&self, hit: &Hit, ray: &Ray, p: &Phong, depth: u32, rng: &mut Rng) -> Color {
-        let n = hit.facing_normal(ray.dir);
+    fn phong(&self, hit: &Hit, ray: &Ray, frame: &Frame, p: &Phong, depth: u32, rng: &mut Rng) -> Color {
+        let n = frame.n;
         let v = -ray.dir;
         let mut c = p.ambient * p.color * self.scene.ambient;
         let highlight = p.specular * p.highlight();
@@ -87,7 +97,8 @@ impl Whitted<'_> {
                     continue;
                 };
                 let cos = inc.dir.dot(n);
-                if !(cos > 0.0) {
+                // Above the shading normal, and above the actual surface.
+                if !(cos > 0.0) || !hit.leaves_as(-n, inc.dir, true) {
                     continue;
                 }
                 // Shadows: a point light only counts blockers before it, a
@@ -102,7 +113,7 @@ impl Whitted<'_> {
             c += sum / count as f32;
         }
         if p.mirror > 0.0 && max_component(p.color) > 0.0 {
-            c += p.mirror * p.color * self.bounce(hit, ray, depth, rng);
+            c += p.mirror * p.color * self.bounce(hit, ray, frame, depth, rng);
         }
         c
     }

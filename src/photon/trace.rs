@@ -314,8 +314,8 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
         return (false, false);
     };
     *power *= scene.transmittance(*departure, hit.t);
-    let n = hit.facing_normal(ray.dir);
     let material = scene.material(hit.prim);
+    let (frame, entering) = hit.scattering_frame(ray.dir, material);
     let first_specular = bounce_now == 0 && material.is_specular();
     let stop = (false, first_specular);
     if material.diffuse_rho().is_some() {
@@ -324,7 +324,7 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
         // indirect light (final gathering counts it).
         let caustic = *only_specular_so_far && *specular_bounces > 0;
         if pass == Pass::Global || caustic {
-            out.push(Photon::new(hit.point, *power, n));
+            out.push(Photon::new(hit.point, *power, frame.n));
         }
     }
     // Russian roulette: survivors carry power / p.
@@ -332,8 +332,6 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
     if p < 1.0 && !(rng.random::<f32>() < p) {
         return stop;
     }
-    let frame = Frame::from_normal(n);
-    let entering = ray.dir.dot(hit.normal) < 0.0;
     let Some(scatter) = material.sample(frame.to_local(-ray.dir), entering, Transport::Importance, rng) else {
         return stop;
     };
@@ -346,9 +344,14 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
         Lobe::Diffuse => frame.to_world(scatter.wi),
         // Specular directions are normalised: a chain of mirror or glass
         // bounces would carry their rounding from one to the next.
-        Lobe::Specular => frame.to_world(scatter.wi).normalize(),
-        Lobe::Glossy => frame.to_world(scatter.wi).normalize(),
+        Lobe::Specular | Lobe::Glossy => frame.to_world(scatter.wi).normalize(),
     };
+    let smooth = hit.shading_normal != hit.normal;
+    // About a shading normal, a sample may leave on the wrong side of the
+    // actual surface: no light goes that way.
+    if smooth && !hit.leaves_as(ray.dir, dir, scatter.wi.z > 0.0) {
+        return stop;
+    }
     match scatter.lobe {
         Lobe::Specular => *specular_bounces += 1,
         // A caustic path ends at its first non-specular bounce.
@@ -356,6 +359,9 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
         _ => *only_specular_so_far = false,
     }
     *power *= scatter.weight / p;
+    if smooth {
+        *power *= hit.adjoint_correction(-ray.dir, dir);
+    }
     if max_component(*power) <= 0.0 || *bounce >= MAX_BOUNCES {
         return stop;
     }

@@ -7,7 +7,7 @@ use crate::accel::Accel;
 use crate::camera::Camera;
 use crate::light::{directional_reach, AreaLight, Emitting, Light};
 use crate::material::Material;
-use crate::math::{max_component, offset_ray_origin, Color, Ray, Vertex};
+use crate::math::{max_component, offset_ray_origin, Color, Frame, Ray, Vertex};
 pub mod file;
 pub mod mesh;
 pub mod procedural;
@@ -53,11 +53,59 @@ impl Hit {
         }
     }
 
-    /// The unit direction in which a perfect mirror at this hit sends a ray
-    /// that arrived travelling along `dir`.
-    pub fn mirrored(&self, dir: Vec3) -> Vec3 {
-        let frame = crate::math::Frame::from_normal(self.facing_normal(dir));
-        frame.to_world(crate::optics::reflect(frame.to_local(-dir))).normalize()
+    /// The frame in which `material` scatters a ray that arrived travelling
+    /// along `dir`: the shading normal's, turned to the ray's side (z is the
+    /// normal, `-dir` has z > 0); the geometric normal's where there is no
+    /// shading normal, or where the shading normal would send the arriving
+    /// ray, or a perfect reflection or refraction of it, to the wrong side
+    /// of the actual surface (a smooth mesh at grazing angles: light would
+    /// leak through it, or be lost). Also whether the ray arrived on the
+    /// front of the geometric normal (glass: entering).
+    #[inline]
+    pub fn scattering_frame(&self, dir: Vec3, material: &crate::material::Material) -> (Frame, bool) {
+        let entering = dir.dot(self.normal) < 0.0;
+        let geometric = self.facing_normal(dir);
+        if self.shading_normal == self.normal {
+            return (Frame::from_normal(geometric), entering);
+        }
+        let n = if entering { self.shading_normal } else { -self.shading_normal };
+        let frame = Frame::from_normal(n);
+        let wo = frame.to_local(-dir);
+        let sides_kept = wo.z > 0.0
+            && material
+                .specular_branches(wo, entering, crate::material::Transport::Radiance)
+                .iter()
+                .all(|b| (frame.to_world(b.wi).dot(geometric) > 0.0) == (b.wi.z > 0.0));
+        if sides_kept {
+            (frame, entering)
+        } else {
+            (Frame::from_normal(geometric), entering)
+        }
+    }
+
+    /// Whether unit `dir`, leaving the surface for a ray that arrived along
+    /// `arrived`, goes where the scattering said: to the side it arrived
+    /// from for a reflection (`reflected`), through for a refraction.
+    #[inline]
+    pub fn leaves_as(&self, arrived: Vec3, dir: Vec3, reflected: bool) -> bool {
+        (dir.dot(self.normal) * arrived.dot(self.normal) < 0.0) == reflected
+    }
+
+    /// The factor a photon's power takes, for shading normals, when it
+    /// arrives along `arrived` and leaves along `left` (Veach 1997, eq.
+    /// 5.21): the adjoint of a BSDF with shading normals is not the BSDF.
+    /// 1 where the shading normal is the geometric one.
+    #[inline]
+    pub fn adjoint_correction(&self, arrived: Vec3, left: Vec3) -> f32 {
+        if self.shading_normal == self.normal {
+            return 1.0;
+        }
+        let (ns, ng) = (self.shading_normal, self.normal);
+        let denominator = arrived.dot(ng).abs() * left.dot(ns).abs();
+        if !(denominator > 0.0) {
+            return 0.0;
+        }
+        arrived.dot(ns).abs() * left.dot(ng).abs() / denominator
     }
 
     /// A ray leaving this hit along unit `dir`, with its departure record.
