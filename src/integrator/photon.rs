@@ -17,13 +17,14 @@
 //! add nothing: those paths belong to the first two rows.
 
 use super::{direct_light, Context, Integrator, Part};
-use crate::material::{Branch, Branches, Material, Transport};
+use crate::material::{Branch, Branches, Lobe, Material, Transport};
 use crate::math::{Color, Frame, Ray};
 use crate::photon::irradiance_cache::{CellRange, IrradianceCache};
 use crate::photon::map::{ConeEstimate, PhotonMap, Scratch};
 use crate::sampling::{cosine_hemisphere, next_2d, stratified_2d};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;
+use rand::RngExt;
 use std::f32::consts::PI;
 
 /// Camera paths split into both the reflected and refracted branch at their
@@ -38,14 +39,6 @@ const MAX_SPECULAR_DEPTH: u32 = 24;
 /// this (cosine) of its own: the same plane, or a curved surface's nearby
 /// point.
 const REUSE_NORMAL_COSINE: f32 = 0.999;
-
-/// A gather ray's diffuse hit: where the cache is read, and with what weight.
-#[derive(Clone, Copy, Default)]
-struct GatherHit {
-    point: glam::Vec3,
-    normal: glam::Vec3,
-    weight: Color,
-}
 
 /// Quality settings of the estimator.
 #[derive(Clone, Copy, Debug)]
@@ -237,7 +230,7 @@ impl PhotonIntegrator<'_> {
                 let dir = frame.to_world(wi).normalize();
                 if hit.leaves_as(-frame.n, dir, true) {
                     let (next, dep) = hit.spawn(dir);
-                    indirect += weight * self.gather(next, dep, w * weight, sh);
+                    indirect += weight * self.gather(next, dep, Lobe::Glossy, w * weight, sh);
                 }
             }
         }
@@ -290,52 +283,25 @@ impl PhotonIntegrator<'_> {
                 continue;
             }
             let (ray, dep) = hit.spawn(dir);
-            let h = self.gather_hit(ray, dep, sh);
-            sum += self.read(&h, w, sh);
+            sum += self.gather(ray, dep, Lobe::Diffuse, w, sh);
         }
         rho * sum / count as f32
     }
 
-    /// Radiance arriving along a gather ray that was reflected by a diffuse
-    /// surface at least once before: followed through mirrors and glass to
-    /// the first diffuse y, where the global map's irradiance is read.
-    fn gather(&self, ray: Ray, dep: Departure, w: Color, sh: &mut Shade) -> Color {
-        if self.cache.is_empty() {
-            return Color::ZERO;
-        }
-        let h = self.gather_hit(ray, dep, sh);
-        self.read(&h, w, sh)
-    }
-
-    /// The irradiance read at gather hit `h` times its weight; or, where
-    /// reads are deferred, zero, the read left for later with weight `w`
-    /// times the hit's (`w`: what the radiance leaving along the gather ray
-    /// is multiplied by on its way to the camera) and its cell's slot
-    /// being fetched.
-    fn read(&self, h: &GatherHit, w: Color, sh: &mut Shade) -> Color {
-        if h.weight == Color::ZERO {
-            return Color::ZERO;
-        }
-        if self.settings.defer_reads {
-            self.cache.prefetch_cell(h.point);
-            sh.thread.pending.push(PendingRead {
-                point: h.point,
-                normal: h.normal,
-                weight: w * h.weight,
-                ..Default::default()
-            });
-            Color::ZERO
-        } else {
-            h.weight * self.cache.lookup(h.point, h.normal, &mut sh.thread.scratch)
-        }
-    }
-
-    /// Where a gather ray, followed through mirrors and glass, meets its
-    /// first diffuse surface y, and the weight (path throughput times
-    /// rho_y / pi) that y's irradiance takes; a zero weight where it meets
-    /// none.
-    fn gather_hit(&self, mut ray: Ray, mut dep: Departure, sh: &mut Shade) -> GatherHit {
+    /// Radiance arriving along a gather ray that left a non-specular lobe
+    /// (`from`), as far as this estimator is the one to count it: followed
+    /// through mirrors and glass and through glossy lobes; at every surface
+    /// met, its diffuse lobe's light is read from the irradiance cache (the
+    /// read left for later, with weight `w` and the path's), and its glossy
+    /// lobe takes its direct light by shadow rays. Light met after mirrors
+    /// or glass counts only where the last non-specular vertex was glossy:
+    /// a diffuse one's is the caustic map's, and light met straight from a
+    /// non-specular vertex is its direct estimate's (notes/method.md).
+    fn gather(&self, mut ray: Ray, mut dep: Departure, mut from: Lobe, w: Color, sh: &mut Shade) -> Color {
         let mut weight = Color::ONE;
+        // A mirror or glass vertex since the last non-specular one.
+        let mut specular = false;
+        let mut found = Color::ZERO;
         for _ in 0..MAX_SPECULAR_DEPTH {
             sh.ctx.counters.rays += 1;
             let Some(y) = self.scene.intersect(&ray, Some(dep)) else {
@@ -343,19 +309,69 @@ impl PhotonIntegrator<'_> {
             };
             weight *= self.scene.transmittance(Some(dep), y.t);
             let material = self.scene.material(y.prim);
+            if from == Lobe::Glossy && specular {
+                found += weight * self.scene.emitted(y.prim, ray.dir);
+            }
+            if material.is_emitter() {
+                break;
+            }
             let (frame, entering) = y.scattering_frame(ray.dir, material);
             if let Some(rho_y) = material.diffuse_rho() {
-                // A Phong surface's mirror lobe is not followed here: its
-                // share of indirect light is left out (notes/scene-format.md).
-                return GatherHit { point: y.point, normal: frame.n, weight: weight * rho_y / PI };
+                found += self.read(y.point, frame.n, weight * rho_y / PI, w, sh);
             }
-            let branches = material.specular_branches(frame.to_local(-ray.dir), entering, Transport::Radiance);
-            let Some(b) = branches.choose(sh.ctx.rng) else { break };
-            weight *= b.scale;
-            let next_dir = frame.to_world(b.wi).normalize();
+            let wo = frame.to_local(-ray.dir);
+            let glossy = material.glossy();
+            if let Some(p) = glossy {
+                let brdf = |l: glam::Vec3| p.glossy(wo, frame.to_local(l));
+                let s = &self.settings;
+                found += weight * direct_light(self.scene, &y, frame.n, brdf, s.shadow_rays, s.skip, sh.ctx);
+            }
+            // On through one of the lobes that are not read here: a specular
+            // branch or the glossy lobe, chosen by what each reflects.
+            let branches = material.specular_branches(wo, entering, Transport::Radiance);
+            let p_specular = match glossy {
+                None => 1.0,
+                Some(_) if branches.is_empty() => 0.0,
+                Some(p) => {
+                    let [_, g, m] = p.lobe_weights();
+                    m / (g + m)
+                }
+            };
+            let next_dir = if p_specular >= 1.0 || (p_specular > 0.0 && sh.ctx.rng.random::<f32>() < p_specular) {
+                let Some(b) = branches.choose(sh.ctx.rng) else { break };
+                weight *= b.scale / p_specular;
+                specular = true;
+                frame.to_world(b.wi).normalize()
+            } else {
+                let Some((wi, gw)) = glossy.and_then(|p| p.sample_glossy(wo, next_2d(sh.ctx.rng))) else { break };
+                weight *= gw / (1.0 - p_specular);
+                (from, specular) = (Lobe::Glossy, false);
+                frame.to_world(wi).normalize()
+            };
+            if y.shading_normal != y.normal && !y.leaves_as(ray.dir, next_dir, frame.to_local(next_dir).z > 0.0) {
+                break;
+            }
             (ray, dep) = y.spawn(next_dir);
         }
-        GatherHit::default()
+        found
+    }
+
+    /// The irradiance read at `point` (on a surface facing `normal`) times
+    /// `weight`; or, where reads are deferred, zero, the read left for later
+    /// with weight `w` times `weight` (`w`: what the radiance leaving along
+    /// the gather ray is multiplied by on its way to the camera) and its
+    /// cell's slot being fetched.
+    fn read(&self, point: glam::Vec3, normal: glam::Vec3, weight: Color, w: Color, sh: &mut Shade) -> Color {
+        if weight == Color::ZERO || self.cache.is_empty() {
+            return Color::ZERO;
+        }
+        if self.settings.defer_reads {
+            self.cache.prefetch_cell(point);
+            sh.thread.pending.push(PendingRead { point, normal, weight: w * weight, ..Default::default() });
+            Color::ZERO
+        } else {
+            weight * self.cache.lookup(point, normal, &mut sh.thread.scratch)
+        }
     }
 
     fn checked(&self, c: Color, estimator: &'static str, sh: &mut Shade) -> Color {
