@@ -124,6 +124,18 @@ pub struct PhotonMap {
     tree_pad: f32,
 }
 
+/// An irradiance estimate: flux over the disk's area pi r^2. Where the disk
+/// also holds photons of another surface, part of it may lie off the
+/// estimate's own surface (beyond an edge, under a contact), which then
+/// holds fewer photons than its share: the estimate is low there unless its
+/// area is corrected.
+#[derive(Clone, Copy, Debug)]
+pub struct IrradianceEstimate {
+    pub irradiance: Color,
+    pub r2: f32,
+    pub other_surfaces: bool,
+}
+
 /// The photons found for one estimate.
 pub struct Gathered {
     /// Squared radius of the disk the estimate divides by.
@@ -408,18 +420,31 @@ impl PhotonMap {
     /// out: for a uniform density the k-1 photons strictly inside the disk
     /// give an unbiased estimate, all k would overestimate by k / (k - 1).
     pub fn irradiance(&self, x: Vec3, n: Vec3, k: usize, r_max: f32, buf: &mut Scratch) -> (Color, f32) {
+        let e = self.irradiance_estimate(x, n, k, r_max, buf);
+        (e.irradiance, e.r2)
+    }
+
+    /// [`Self::irradiance`], and whether the disk held photons of another
+    /// surface: an edge, a corner or a contact is within it, and part of
+    /// the disk may lie off the surface (see [`IrradianceEstimate`]).
+    pub fn irradiance_estimate(&self, x: Vec3, n: Vec3, k: usize, r_max: f32, buf: &mut Scratch) -> IrradianceEstimate {
         let g = self.gather(x, k, r_max, buf);
         if g.count == 0 || !(g.r2 > 0.0) {
-            return (Color::ZERO, g.r2);
+            return IrradianceEstimate { irradiance: Color::ZERO, r2: g.r2, other_surfaces: false };
         }
         let on_rim_excluded = g.r2 < r_max * r_max;
         let mut flux = Color::ZERO;
+        let mut other_surfaces = false;
         for (d2, i) in buf.buf[..buf.found].iter().map(|&key| unpack(key)) {
-            if (!on_rim_excluded || d2 < g.r2) && self.faces(i, n) {
-                flux += self.photons[i as usize].flux();
+            if !on_rim_excluded || d2 < g.r2 {
+                if self.faces(i, n) {
+                    flux += self.photons[i as usize].flux();
+                } else {
+                    other_surfaces = true;
+                }
             }
         }
-        (flux / (PI * g.r2), g.r2)
+        IrradianceEstimate { irradiance: flux / (PI * g.r2), r2: g.r2, other_surfaces }
     }
 
     /// Radiance reflected by a Lambertian surface of reflectance `rho`,

@@ -110,7 +110,10 @@ pub fn photon_pass(
     stats.tree_time += t.elapsed();
     let t = Instant::now();
     let stride = settings.cache_stride.unwrap_or_else(|| cache_stride(est.k_global));
-    let cache = IrradianceCache::build(&global_map, stride, est.k_global, est.r_global);
+    // Estimates near an edge or a contact are divided by the part of
+    // their disk that lies on their surface.
+    let coverage = |x, n, r| scene.disk_coverage(x, n, r, COVERAGE_SAMPLES);
+    let cache = IrradianceCache::build_with(&global_map, stride, est.k_global, est.r_global, &coverage);
     stats.cache_time += t.elapsed();
     stats.global_stored = global_map.len();
     stats.caustic_stored = caustic_map.len();
@@ -118,6 +121,10 @@ pub fn photon_pass(
     stats.map_bytes = global_map.memory_bytes() + caustic_map.memory_bytes();
     Maps { caustic: caustic_map, cache }
 }
+
+/// Rays measuring the part of an estimate's disk that lies on its surface
+/// (where the disk holds another surface's photons).
+const COVERAGE_SAMPLES: u32 = 32;
 
 /// The global map's grid cells, as a fraction of its radius cap: sized
 /// for the radius its estimates need (the k-th photon's distance, a few

@@ -365,6 +365,36 @@ impl Scene {
         }
     }
 
+    /// The fraction of the disk of radius `r` around `x`, in the plane of
+    /// unit normal `n` (x's surface, on the side `n` faces), that lies on a
+    /// surface facing like x's: the part of a density estimate's disk that
+    /// can hold its photons. Measured at a fixed pattern of `samples`
+    /// points: each counts where a short ray down from just above it meets
+    /// a surface facing within 25 degrees of `n` within twice that height.
+    /// Beyond an edge nothing is met (or a surface facing elsewhere); under
+    /// an object standing on the surface, its underside is met.
+    pub fn disk_coverage(&self, x: Vertex, n: Vec3, r: f32, samples: u32) -> f32 {
+        if !(r > 0.0) || samples == 0 {
+            return 1.0;
+        }
+        let frame = Frame::from_normal(n);
+        let height = 0.05 * r + 1e-5 * x.abs().max_element();
+        let mut on = 0;
+        for i in 0..samples {
+            // A Fermat spiral: equal areas per sample, no random numbers.
+            let radius = r * ((i as f32 + 0.5) / samples as f32).sqrt();
+            let angle = i as f32 * 2.399_963;
+            let q = x + radius * (angle.cos() * frame.s + angle.sin() * frame.t);
+            let ray = Ray::new(q + height * n, -n);
+            if let Some(h) = self.intersect(&ray, None) {
+                let facing = if h.normal.dot(n) >= 0.0 { h.normal } else { -h.normal };
+                let same_side = h.normal.dot(-n) < 0.0;
+                on += (h.t <= 2.0 * height && same_side && facing.dot(n) >= 0.9) as u32;
+            }
+        }
+        on as f32 / samples as f32
+    }
+
     /// Number of primitives (the area lights' surfaces included).
     pub fn prim_count(&self) -> usize {
         self.prim_material.len()
@@ -547,6 +577,30 @@ mod tests {
         // Half the directions go back (kind 2 always does).
         assert!(back > 30_000, "{back}");
         assert!(sphere_rehits > 100, "the sphere's chords were checked {sphere_rehits} times");
+    }
+
+    /// The part of an estimate's disk on its surface: all of it on the open
+    /// floor, half of it at a wall's foot, a quarter in a corner of the
+    /// room; less where the tetrahedron stands on the floor.
+    #[test]
+    fn disk_coverage_is_the_part_of_the_disk_on_the_surface() {
+        let scene = Scene::tncg15(Eye::One);
+        let up = Vec3::Z;
+        let cover = |x: Vec3, n: Vec3| scene.disk_coverage(x, n, 0.5, 256);
+        assert_eq!(cover(Vec3::new(5.0, 0.0, -5.0), up), 1.0);
+        // The wall P1-P2 is y = 6 for x in [0, 10].
+        let foot = cover(Vec3::new(5.0, 6.0, -5.0), up);
+        assert!((foot - 0.5).abs() < 0.03, "{foot}");
+        // The corner P2: walls P1-P2 (y = 6) and P2-P3 meet at (10, 6); the
+        // angle there is 116.6 degrees, so a little under a third of the disk.
+        let corner = cover(Vec3::new(10.0, 6.0, -5.0), up);
+        let want = (180.0 - 63.43) / 360.0;
+        assert!((corner - want).abs() < 0.03, "{corner} vs {want}");
+        // Beside the tetrahedron's base (A, B at x = 10.8): partly under it.
+        let under = cover(Vec3::new(10.9, 0.0, -5.0), up);
+        assert!(under > 0.1 && under < 0.9, "{under}");
+        // On a wall, facing into the room.
+        assert_eq!(cover(Vec3::new(5.0, 6.0, 0.0), -Vec3::Y), 1.0);
     }
 
     #[test]
