@@ -110,6 +110,29 @@ fn nudge(x: f32, towards: f32) -> f32 {
     f32::from_bits((next & moves) | (bits & !moves))
 }
 
+/// A unit vector in 32 bits: its octahedral map (Meyer et al. 2010), two
+/// 16-bit coordinates; decoded within 1e-4 of the direction (tested). For
+/// the vertex normals of large meshes (12 bytes a triangle, not 36).
+pub fn encode_unit(n: Vec3) -> u32 {
+    let n = n / (n.x.abs() + n.y.abs() + n.z.abs());
+    let (mut x, mut y) = (n.x, n.y);
+    if n.z < 0.0 {
+        (x, y) = ((1.0 - n.y.abs()) * n.x.signum(), (1.0 - n.x.abs()) * n.y.signum());
+    }
+    let q = |v: f32| (((v.clamp(-1.0, 1.0) * 0.5 + 0.5) * 65535.0).round() as u32) & 0xFFFF;
+    q(x) | (q(y) << 16)
+}
+
+/// The unit vector [`encode_unit`] wrote.
+pub fn decode_unit(bits: u32) -> Vec3 {
+    let d = |v: u32| (v & 0xFFFF) as f32 / 65535.0 * 2.0 - 1.0;
+    let (x, y) = (d(bits), d(bits >> 16));
+    let z = 1.0 - x.abs() - y.abs();
+    let t = (-z).max(0.0);
+    let n = Vec3::new(x - t.copysign(x), y - t.copysign(y), z);
+    n.normalize()
+}
+
 /// Largest component, used for Russian roulette on RGB weights.
 pub fn max_component(c: Color) -> f32 {
     c.x.max(c.y).max(c.z)
@@ -140,6 +163,20 @@ mod tests {
             }
         }
         assert!(worst < 1e-6, "worst |length - 1| = {worst:e}");
+    }
+
+    #[test]
+    fn unit_vectors_survive_their_32_bit_code() {
+        use crate::sampling::{next_2d, stream, uniform_cone, Domain};
+        let mut rng = stream(5, Domain::Camera, 1);
+        let mut worst = 0.0f32;
+        let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z, Vec3::new(1.0, -1.0, -1.0).normalize()];
+        for n in axes.into_iter().chain((0..200_000).map(|_| uniform_cone(next_2d(&mut rng), -1.0).normalize())) {
+            let back = decode_unit(encode_unit(n));
+            worst = worst.max((back - n).length());
+            assert!((back.length() - 1.0).abs() < 1e-6);
+        }
+        assert!(worst < 1e-4, "worst error {worst:e}");
     }
 
     #[test]

@@ -13,6 +13,9 @@ use glam::{Vec3, Vec3A, Vec4};
 
 const BINS: usize = 16;
 const MAX_LEAF: usize = 4;
+/// A step into a node, in units of a primitive's test (the surface area
+/// heuristic's traversal cost).
+const TRAVERSAL_COST: f32 = 1.0;
 
 #[derive(Clone, Copy, Debug)]
 struct Node {
@@ -36,10 +39,10 @@ struct Node4 {
     max: [Vec4; 3],
     /// Interior child: its node. Leaf child: its first primitive in leaf order.
     child: [u32; 4],
-    /// Primitives of a leaf child; 0 for an interior child.
-    count: [u32; 4],
+    /// Primitives of a leaf child (at most MAX_LEAF); 0 for an interior child.
+    count: [u8; 4],
     /// Bit k set where lane k holds a child.
-    used: u32,
+    used: u8,
 }
 
 /// Entries the traversal stack holds. A node pushes at most three more
@@ -75,11 +78,10 @@ impl Bvh {
             .enumerate()
             .map(|(i, &(min, max))| Item { min, max, centroid: 0.5 * (min + max), index: i as u32 })
             .collect();
-        let mut binary = Vec::with_capacity(2 * items.len().max(1));
-        binary.push(Node { min: Vec3::ZERO, max: Vec3::ZERO, first: 0, count: 0 });
         let mut nodes = Vec::new();
         if !items.is_empty() {
-            build(&mut binary, 0, &mut items, 0);
+            let binary = subtree(&mut items, 0);
+            nodes.reserve(binary.len() / 3 + 1);
             collapse(&binary, &mut nodes, 0);
         }
         (Bvh { nodes }, items.iter().map(|it| it.index).collect())
@@ -119,8 +121,9 @@ impl Bvh {
         loop {
             let n = &self.nodes[node as usize];
             let (t_in, t_out) = entries(n, origin, inv);
-            let mut hits =
-                (t_in.cmple(t_out) & t_in.cmple(Vec4::splat(t_limit)) & t_in.cmplt(Vec4::INFINITY)).bitmask() & n.used;
+            let mut hits = (t_in.cmple(t_out) & t_in.cmple(Vec4::splat(t_limit)) & t_in.cmplt(Vec4::INFINITY))
+                .bitmask()
+                & n.used as u32;
             let t_in = t_in.to_array();
             // The boxes entered, nearest first (on a tie, the lower lane).
             let mut order = [0usize; 4];
@@ -211,33 +214,41 @@ fn collapse(binary: &[Node], out: &mut Vec<Node4>, root: usize) -> u32 {
     let mut min = [[0.0f32; 4]; 3];
     let mut max = [[0.0f32; 4]; 3];
     let mut child = [0u32; 4];
-    let mut count = [0u32; 4];
+    let mut count = [0u8; 4];
     for (lane, &k) in kids.iter().enumerate() {
         let b = &binary[k];
         for a in 0..3 {
             min[a][lane] = b.min[a];
             max[a][lane] = b.max[a];
         }
-        (child[lane], count[lane]) = if b.count > 0 { (b.first, b.count) } else { (collapse(binary, out, k), 0) };
+        (child[lane], count[lane]) = if b.count > 0 { (b.first, b.count as u8) } else { (collapse(binary, out, k), 0) };
     }
     out[index] = Node4 {
         min: min.map(Vec4::from_array),
         max: max.map(Vec4::from_array),
         child,
         count,
-        used: (1u32 << kids.len()) - 1,
+        used: (1u8 << kids.len()) - 1,
     };
     index as u32
 }
 
-fn build(nodes: &mut Vec<Node>, node: usize, items: &mut [Item], offset: u32) {
-    let (min, max) = items.iter().fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(a, b), it| {
-        (a.min(it.min), b.max(it.max))
-    });
-    let leaf = Node { min, max, first: offset, count: items.len() as u32 };
+/// The smallest box holding the items' boxes.
+fn item_bounds(items: &[Item]) -> (Vec3, Vec3) {
+    items
+        .iter()
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(a, b), it| (a.min(it.min), b.max(it.max)))
+}
+
+/// How a node of `items` (bounds `min`, `max`) is split: the items
+/// partitioned and the size of the first part, or `None` for a leaf. The
+/// binned surface area heuristic along the widest axis of the centroids,
+/// a step into a node costing as much as a primitive's test (so two to
+/// four primitives make a leaf rather than a chain of nodes of one each);
+/// halves by count where the centroids coincide.
+fn split(items: &mut [Item], min: Vec3, max: Vec3) -> Option<usize> {
     if items.len() <= 1 {
-        nodes[node] = leaf;
-        return;
+        return None;
     }
     let (cmin, cmax) = items.iter().fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(a, b), it| {
         (a.min(it.centroid), b.max(it.centroid))
@@ -250,62 +261,97 @@ fn build(nodes: &mut Vec<Node>, node: usize, items: &mut [Item], offset: u32) {
     } else {
         2
     };
-    let mid = if extent[axis] > 0.0 {
-        // Binned SAH along the widest centroid axis.
-        let bin_of =
-            |it: &Item| (((it.centroid[axis] - cmin[axis]) / extent[axis] * BINS as f32) as usize).min(BINS - 1);
-        let mut counts = [0usize; BINS];
-        let mut bounds = [(Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)); BINS];
-        for it in items.iter() {
-            let b = bin_of(it);
-            counts[b] += 1;
-            bounds[b] = (bounds[b].0.min(it.min), bounds[b].1.max(it.max));
+    if !(extent[axis] > 0.0) {
+        return (items.len() > MAX_LEAF).then_some(items.len() / 2);
+    }
+    let bin_of = |it: &Item| (((it.centroid[axis] - cmin[axis]) / extent[axis] * BINS as f32) as usize).min(BINS - 1);
+    let mut counts = [0usize; BINS];
+    let mut bounds = [(Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)); BINS];
+    for it in items.iter() {
+        let b = bin_of(it);
+        counts[b] += 1;
+        bounds[b] = (bounds[b].0.min(it.min), bounds[b].1.max(it.max));
+    }
+    let mut best = (f32::INFINITY, 0usize);
+    for split in 1..BINS {
+        let side = |range: std::ops::Range<usize>| {
+            range.fold((0usize, Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(c, a, b), i| {
+                (c + counts[i], a.min(bounds[i].0), b.max(bounds[i].1))
+            })
+        };
+        let (nl, al, bl) = side(0..split);
+        let (nr, ar, br) = side(split..BINS);
+        if nl == 0 || nr == 0 {
+            continue;
         }
-        let mut best = (f32::INFINITY, 0usize);
-        for split in 1..BINS {
-            let side = |range: std::ops::Range<usize>| {
-                range.fold((0usize, Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(c, a, b), i| {
-                    (c + counts[i], a.min(bounds[i].0), b.max(bounds[i].1))
-                })
-            };
-            let (nl, al, bl) = side(0..split);
-            let (nr, ar, br) = side(split..BINS);
-            if nl == 0 || nr == 0 {
-                continue;
-            }
-            let cost = nl as f32 * area(al, bl) + nr as f32 * area(ar, br);
-            if cost < best.0 {
-                best = (cost, split);
-            }
+        let cost = nl as f32 * area(al, bl) + nr as f32 * area(ar, br);
+        if cost < best.0 {
+            best = (cost, split);
         }
-        let leaf_cost = items.len() as f32 * area(min, max);
-        if best.1 == 0 || (best.0 >= leaf_cost && items.len() <= MAX_LEAF) {
-            if items.len() <= MAX_LEAF {
-                nodes[node] = leaf;
-                return;
-            }
-            items.len() / 2
-        } else {
-            let mut i = 0;
-            for j in 0..items.len() {
-                if bin_of(&items[j]) < best.1 {
-                    items.swap(i, j);
-                    i += 1;
-                }
-            }
-            i
+    }
+    let node_area = area(min, max);
+    let leaf_cost = items.len() as f32 * node_area;
+    if best.1 == 0 || (best.0 + TRAVERSAL_COST * node_area >= leaf_cost && items.len() <= MAX_LEAF) {
+        return (items.len() > MAX_LEAF).then_some(items.len() / 2);
+    }
+    let mut i = 0;
+    for j in 0..items.len() {
+        if bin_of(&items[j]) < best.1 {
+            items.swap(i, j);
+            i += 1;
         }
-    } else if items.len() <= MAX_LEAF {
-        nodes[node] = leaf;
+    }
+    Some(i)
+}
+
+/// Builds the binary hierarchy over `items` into `nodes[node]` and nodes
+/// pushed after it (an interior node's children adjacent); leaves index
+/// the items' order from `offset`.
+fn build(nodes: &mut Vec<Node>, node: usize, items: &mut [Item], offset: u32) {
+    let (min, max) = item_bounds(items);
+    let Some(mid) = split(items, min, max) else {
+        nodes[node] = Node { min, max, first: offset, count: items.len() as u32 };
         return;
-    } else {
-        items.len() / 2
     };
     let first = nodes.len();
-    nodes.push(leaf);
-    nodes.push(leaf);
+    let placeholder = Node { min, max, first: 0, count: 0 };
+    nodes.push(placeholder);
+    nodes.push(placeholder);
     nodes[node] = Node { min, max, first: first as u32, count: 0 };
     let (left, right) = items.split_at_mut(mid);
     build(nodes, first, left, offset);
     build(nodes, first + 1, right, offset + mid as u32);
+}
+
+/// Items below which a subtree is built on one thread.
+const PARALLEL_MIN: usize = 1 << 14;
+
+/// The binary hierarchy over `items` as its own array, root first: the
+/// top levels' two halves built at once on the thread pool, each subtree
+/// below `PARALLEL_MIN` items by [`build`], then stitched (the same tree as
+/// one thread builds, node for node).
+fn subtree(items: &mut [Item], offset: u32) -> Vec<Node> {
+    let (min, max) = item_bounds(items);
+    if items.len() < PARALLEL_MIN {
+        let mut nodes = Vec::with_capacity(2 * items.len().max(1));
+        nodes.push(Node { min, max, first: 0, count: 0 });
+        build(&mut nodes, 0, items, offset);
+        return nodes;
+    }
+    let Some(mid) = split(items, min, max) else {
+        return vec![Node { min, max, first: offset, count: items.len() as u32 }];
+    };
+    let (l, r) = items.split_at_mut(mid);
+    let (left, right) = rayon::join(|| subtree(l, offset), || subtree(r, offset + mid as u32));
+    // Root, the two subtrees' roots, then the rest of each: old index i of
+    // the left tree (i >= 1) becomes i + 2, of the right i + left.len() + 1.
+    let moved = |n: &Node, by: u32| if n.count == 0 { Node { first: n.first + by, ..*n } } else { *n };
+    let (by_left, by_right) = (2, left.len() as u32 + 1);
+    let mut out = Vec::with_capacity(1 + left.len() + right.len());
+    out.push(Node { min, max, first: 1, count: 0 });
+    out.push(moved(&left[0], by_left));
+    out.push(moved(&right[0], by_right));
+    out.extend(left[1..].iter().map(|n| moved(n, by_left)));
+    out.extend(right[1..].iter().map(|n| moved(n, by_right)));
+    out
 }

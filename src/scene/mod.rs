@@ -148,8 +148,9 @@ pub struct Scene {
     /// accelerator, in the order it visits them.
     prim_material: Vec<u32>,
     prim_light: Vec<u32>,
-    /// Vertex normals of the smooth triangles ([`crate::shape::Triangle::shading`]).
-    shading_normals: Vec<[Vec3; 3]>,
+    /// Vertex normals of the smooth triangles ([`crate::shape::Triangle::shading`]),
+    /// in 32 bits each ([`crate::math::encode_unit`]).
+    shading_normals: Vec<[u32; 3]>,
     accel: Accel,
     bounds: (Vec3, Vec3),
     targets: Vec<Target>,
@@ -330,7 +331,7 @@ impl Scene {
             camera,
             prim_material,
             prim_light,
-            shading_normals,
+            shading_normals: shading_normals.iter().map(|n| n.map(crate::math::encode_unit)).collect(),
             accel,
             bounds: (lo, hi),
             targets,
@@ -355,9 +356,10 @@ impl Scene {
     /// winding when the mesh was read).
     #[inline]
     fn shading_normal(&self, h: &ShapeHit) -> Vec3 {
-        let Some(&[n0, n1, n2]) = self.shading_normals.get(h.shading as usize) else {
+        let Some(&codes) = self.shading_normals.get(h.shading as usize) else {
             return h.normal;
         };
+        let [n0, n1, n2] = codes.map(crate::math::decode_unit);
         let [u, v] = h.uv;
         match ((1.0 - u - v) * n0 + u * n1 + v * n2).try_normalize() {
             Some(n) if n.dot(h.normal) > 0.0 => n,
@@ -393,6 +395,14 @@ impl Scene {
             }
         }
         on as f32 / samples as f32
+    }
+
+    /// Bytes the scene's geometry holds: the shapes and the accelerator,
+    /// the per-primitive material and light, the vertex normals.
+    pub fn memory_bytes(&self) -> usize {
+        self.accel.memory_bytes()
+            + (self.prim_material.capacity() + self.prim_light.capacity()) * 4
+            + self.shading_normals.capacity() * std::mem::size_of::<[u32; 3]>()
     }
 
     /// Number of primitives (the area lights' surfaces included).
