@@ -104,6 +104,7 @@ impl Bvh {
 
     /// Visits the leaves whose boxes the ray enters before `t_limit`, nearer
     /// boxes first; `visit` may shrink `t_limit`, and returns true to stop.
+    #[inline(always)]
     pub fn traverse(&self, ray: &Ray, t_max: f32, mut visit: impl FnMut(std::ops::Range<usize>, &mut f32) -> bool) {
         if self.nodes.is_empty() {
             return;

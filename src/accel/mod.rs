@@ -169,6 +169,7 @@ impl Accel {
     /// Visits the shapes in the leaves whose boxes the ray enters before
     /// `t_max`, nearer boxes first (all of them when there is no
     /// hierarchy); `visit` may shrink the reach, and returns true to stop.
+    #[inline(always)]
     fn traverse<'s>(&'s self, ray: &Ray, t_max: f32, mut visit: impl FnMut(&'s Shape, u32, &mut f32) -> bool) {
         if self.bvh.is_empty() {
             let mut t_limit = t_max;

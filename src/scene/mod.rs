@@ -339,6 +339,7 @@ impl Scene {
         }
     }
 
+    #[inline]
     pub fn intersect(&self, ray: &Ray, departure: Option<Departure>) -> Option<Hit> {
         self.accel.closest_hit(ray, departure, f32::INFINITY).map(|(prim, h)| Hit {
             t: h.t,
