@@ -68,7 +68,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (name, settings) in [("ppm", ppm), ("path", path)] {
         for &budget in budgets {
             let t = Instant::now();
-            let (film, stats) = render_progressive(&scene, &settings, Budget::Seconds(budget), |_| {});
+            let (film, stats) = render_progressive(&scene, &settings, Budget::seconds(budget), |_| {});
             let seconds = t.elapsed().as_secs_f64();
             let m = compare(&film, &reference).ok_or("size")?;
             record(Row { integrator: name, setting: format!("{budget} s budget"), seconds, passes: stats.passes, m });

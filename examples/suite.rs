@@ -100,7 +100,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ..settings
             };
             let load = std::time::Duration::ZERO;
-            let (film, stats) = render_progressive(&scene, &p, Budget::Seconds(seconds - load.as_secs_f64()), |_| {});
+            let (film, stats) = render_progressive(&scene, &p, Budget::seconds(seconds - load.as_secs_f64()), |_| {});
             let scored = score(&film, t.elapsed().as_secs_f64(), stats.passes as u64)?;
             eprintln!(
                 "{:<16} progressive {:>7.1} s  rmse {:.5}  caustic {:.5}  ({} passes)",

@@ -16,6 +16,9 @@ pub struct Camera {
     down: Vec3,
     pub width: u32,
     pub height: u32,
+    /// Whether the image plane may grow to another aspect ratio (a look-at
+    /// camera's may; the course's four corners are the user's exact plane).
+    pub widens: bool,
 }
 
 impl Camera {
@@ -25,7 +28,62 @@ impl Camera {
     pub fn from_corners(eye: Vertex, corners: [Vertex; 4], width: u32, height: u32) -> Self {
         // The lower-right corner is implied by the other three (a rectangle).
         let [_, lower_left, upper_left, upper_right] = corners;
-        Camera { eye, upper_left, across: upper_right - upper_left, down: lower_left - upper_left, width, height }
+        Camera {
+            eye,
+            upper_left,
+            across: upper_right - upper_left,
+            down: lower_left - upper_left,
+            width,
+            height,
+            widens: false,
+        }
+    }
+
+    /// A camera whose plane may widen to other aspect ratios ([`Self::fit`]).
+    pub fn widening(mut self) -> Self {
+        self.widens = true;
+        self
+    }
+
+    /// The image plane's width over its height.
+    pub fn aspect(&self) -> f32 {
+        self.across.length() / self.down.length()
+    }
+
+    /// The camera at `width` x `height` pixels without stretching the
+    /// picture: a plane of the same aspect takes the resolution as it is; a
+    /// widening camera's plane grows about its centre along the side that
+    /// the new aspect makes longer (the view only gains); a fixed plane of
+    /// another aspect is refused, with the sizes that would fit.
+    pub fn fit(self, width: u32, height: u32) -> Result<Camera, String> {
+        let plane = self.aspect();
+        // Within half a pixel of the plane's shape: the rounding of a size.
+        let fits = (width as f32 - plane * height as f32).abs() <= 0.5
+            || (height as f32 - width as f32 / plane).abs() <= 0.5;
+        if fits {
+            return Ok(self.with_resolution(width, height));
+        }
+        if !self.widens {
+            let h_for_w = (width as f32 / plane).round().max(1.0);
+            let w_for_h = (plane * height as f32).round().max(1.0);
+            return Err(format!(
+                "{width}x{height} pixels would stretch the picture: the camera's image plane is {plane:.4}:1 \
+                 (its four corners); give {width}x{h_for_w} or {w_for_h}x{height}, or move the corners \
+                 (a look-at camera, with target, up and vfov, widens its view to any size)"
+            ));
+        }
+        let wanted = width as f32 / height as f32;
+        let mut c = self;
+        if wanted > plane {
+            let grow = wanted / plane;
+            c.upper_left -= c.across * (grow - 1.0) * 0.5;
+            c.across *= grow;
+        } else {
+            let grow = plane / wanted;
+            c.upper_left -= c.down * (grow - 1.0) * 0.5;
+            c.down *= grow;
+        }
+        Ok(c.with_resolution(width, height))
     }
 
     /// The image plane: its top-left corner, and the vectors from there to
@@ -84,5 +142,33 @@ mod tests {
         let cam2 = Scene::tncg15(Eye::Two).camera;
         let fov2 = cam2.ray(400, 0, Vec2::ZERO).dir.angle_between(cam2.ray(400, 799, Vec2::new(0.0, 1.0)).dir);
         assert!((fov2.to_degrees() - 90.0).abs() < 0.01);
+    }
+
+    /// Other image sizes keep the picture's proportions: a widening camera
+    /// gains view along the longer side (the original view stays in the
+    /// middle, at the same scale); a fixed plane of another shape is
+    /// refused with the sizes that fit.
+    #[test]
+    fn other_sizes_keep_the_aspect() {
+        let square = Scene::tncg15(Eye::One).camera;
+        let wide = square.widening().fit(400, 200).unwrap();
+        let (_, across, down) = wide.plane();
+        assert!((across.length() / down.length() - 2.0).abs() < 1e-5);
+        // Pixels stay square: the same angle a pixel across and down.
+        let (a, b, c) = (wide.ray(200, 100, Vec2::ZERO), wide.ray(201, 100, Vec2::ZERO), wide.ray(200, 101, Vec2::ZERO));
+        let (h, v) = (a.dir.angle_between(b.dir), a.dir.angle_between(c.dir));
+        assert!((h / v - 1.0).abs() < 1e-3, "{h} vs {v}");
+        // The centre ray and the vertical field of view are unchanged.
+        let centre = square.ray(400, 400, Vec2::ZERO).dir;
+        assert!(wide.ray(200, 100, Vec2::ZERO).dir.angle_between(centre) < 1e-5);
+        let fov = wide.ray(200, 0, Vec2::ZERO).dir.angle_between(wide.ray(200, 199, Vec2::new(0.0, 1.0)).dir);
+        assert!((fov.to_degrees() - 53.130).abs() < 0.01);
+        let tall = square.widening().fit(100, 300).unwrap();
+        let (_, across, down) = tall.plane();
+        assert!((down.length() / across.length() - 3.0).abs() < 1e-5);
+        // The same shape at another size, and a fixed plane refused.
+        assert!(square.fit(160, 160).is_ok());
+        let err = square.fit(400, 200).unwrap_err();
+        assert!(err.contains("400x400 or 200x200"), "{err}");
     }
 }

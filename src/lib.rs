@@ -21,10 +21,12 @@
 
 pub mod accel;
 pub mod camera;
+pub mod display;
 pub mod error;
 pub mod export;
 pub mod film;
 pub mod integrator;
+pub mod interrupt;
 pub mod light;
 pub mod material;
 pub mod math;
@@ -34,6 +36,7 @@ pub mod optics;
 pub mod output;
 pub mod photon;
 pub mod progress;
+pub mod provenance;
 pub mod render;
 pub mod sampling;
 pub mod scene;

@@ -9,12 +9,14 @@ impl Settings {
     /// roulette with albedo 0.8), each 28 bytes plus ~16 in the kd-tree and
     /// as much again while the tree is built (a bound: a global map that
     /// keeps its grid builds no tree); one caustic photon per emitted
-    /// one; the film in f32 and its rows in flight.
-    pub fn estimated_peak_bytes(&self) -> u64 {
+    /// one; the film in f32 and its rows in flight; for a progressive
+    /// render, the passes' exact sums (144 bytes a pixel) and the average.
+    pub fn estimated_peak_bytes(&self, progressive: bool) -> u64 {
         let per_photon = std::mem::size_of::<crate::photon::Photon>() as u64 + 16 + 24;
         let global = self.photons.saturating_mul(5).saturating_mul(per_photon);
         let caustic = self.caustic_photons.saturating_mul(per_photon);
-        let film = (self.width as u64) * (self.height as u64) * 2 * 12;
+        let pixels = (self.width as u64) * (self.height as u64);
+        let film = pixels * 2 * 12 + if progressive { pixels * (144 + 12 * 4) } else { 0 };
         global.saturating_add(caustic).saturating_add(film)
     }
 }

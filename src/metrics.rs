@@ -67,7 +67,7 @@ impl Window {
         Ok(Window { name, rows: range(rows)?, cols: range(cols)? })
     }
 
-    fn contains(&self, row: u32, col: u32) -> bool {
+    pub fn contains(&self, row: u32, col: u32) -> bool {
         (self.rows.0..self.rows.1).contains(&row) && (self.cols.0..self.cols.1).contains(&col)
     }
 }
@@ -345,6 +345,31 @@ pub fn diff_rgb8(test: &Film, reference: &Film, scale: Option<f32>) -> (Vec<u8>,
             } else {
                 [warm, warm, hot]
             }
+        })
+        .collect();
+    (px, scale)
+}
+
+/// A heat map of non-negative per-pixel values (an error estimate): black
+/// at 0 through red and yellow to white at `scale` (the 99th percentile of
+/// the values when `None`) and beyond. Returns the pixels and the scale.
+pub fn heat_rgb8(values: &Film, scale: Option<f32>) -> (Vec<u8>, f32) {
+    let v: Vec<f32> = values.pixels.iter().map(|&c| brightness(c)).collect();
+    let scale = scale.unwrap_or_else(|| {
+        let mut finite: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();
+        if finite.is_empty() {
+            return 1.0;
+        }
+        let k = ((finite.len() as f64 * 0.99) as usize).min(finite.len() - 1);
+        *finite.select_nth_unstable_by(k, f32::total_cmp).1
+    });
+    let scale = if scale > 0.0 && scale.is_finite() { scale } else { 1.0 };
+    let px = v
+        .iter()
+        .flat_map(|&x| {
+            let t = if x.is_finite() { (x / scale).clamp(0.0, 1.0) } else { 1.0 };
+            let ramp = |a: f32| (255.0 * (3.0 * t - a).clamp(0.0, 1.0)) as u8;
+            [ramp(0.0), ramp(1.0), ramp(2.0)]
         })
         .collect();
     (px, scale)

@@ -68,48 +68,85 @@ impl Phase {
     }
 }
 
-/// Progress of a progressive render: passes done, radii, time left.
+/// Progress of a progressive render: passes done, radii, predicted
+/// error, time left.
 pub struct PassDisplay {
     mode: Mode,
     budget: Budget,
+    first: u32,
     bar: Option<ProgressBar>,
+    last_line: std::cell::Cell<Option<std::time::Instant>>,
 }
 
 impl PassDisplay {
-    pub fn new(mode: Mode, budget: Budget) -> Self {
+    /// `first`: the first pass this run renders (a resumed render's passes
+    /// before it are done already).
+    pub fn new(mode: Mode, budget: Budget, first: u32) -> Self {
         let bar = (mode == Mode::Bar).then(|| {
-            let len = match budget {
-                Budget::Passes(n) => n as u64,
-                Budget::Seconds(s) => s.ceil() as u64,
+            let bar = match (budget.end, budget.seconds) {
+                (Some(n), _) => ProgressBar::new(n.saturating_sub(first) as u64),
+                (None, Some(s)) => ProgressBar::new(s.ceil() as u64),
+                (None, None) => ProgressBar::new_spinner(),
             };
-            let bar = ProgressBar::new(len);
             if let Ok(style) = ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}") {
                 bar.set_style(style.progress_chars("=> "));
             }
             bar
         });
-        PassDisplay { mode, budget, bar }
+        PassDisplay { mode, budget, first, bar, last_line: std::cell::Cell::new(None) }
+    }
+
+    /// Seconds left by the budget's nearest limit (None: unknown yet).
+    fn left(&self, r: &PassReport) -> Option<f64> {
+        let elapsed = r.elapsed.as_secs_f64();
+        let per_pass = elapsed / r.rendered.max(1) as f64;
+        let mut left: Option<f64> = None;
+        let mut take = |v: f64| left = Some(left.map_or(v, |l: f64| l.min(v)));
+        if let Some(end) = self.budget.end {
+            take(per_pass * end.saturating_sub(self.first + r.rendered) as f64);
+        }
+        if let Some(s) = self.budget.seconds {
+            take((s - elapsed).max(0.0));
+        }
+        if let Some(target) = self.budget.target_error {
+            // Noise falls as the square root of the passes: the passes
+            // the worst region needs, from its error now.
+            let worst = r.predictions.iter().skip((!self.budget.windows.is_empty()) as usize);
+            if let Some(e) = worst.map(|(_, p)| p.relative_rmse()).reduce(f64::max) {
+                let need = r.passes as f64 * (e / target).powi(2);
+                take(per_pass * (need - r.passes as f64).max(0.0));
+            }
+        }
+        left
     }
 
     pub fn update(&self, r: &PassReport) {
         let elapsed = r.elapsed.as_secs_f64();
-        let left = match self.budget {
-            Budget::Passes(n) => elapsed / r.passes as f64 * (n.saturating_sub(r.passes)) as f64,
-            Budget::Seconds(s) => (s - elapsed).max(0.0),
-        };
-        let msg = format!(
-            "pass {:>5}  k {} / radius cap {:.4} (caustic), k {} / {:.4} (global)  {:>7.1} s elapsed  {:>7.1} s left",
-            r.passes, r.k_caustic, r.r_caustic, r.k_global, r.r_global, elapsed, left
-        );
+        let mut msg = format!("pass {:>5}  radius cap {:.4} caustic, {:.4} global", r.passes, r.r_caustic, r.r_global);
+        for (name, p) in &r.predictions {
+            msg += &format!("  {name} ±{:.1}%", 100.0 * p.relative_rmse());
+        }
+        msg += &format!("  {elapsed:.1} s");
+        if let Some(left) = self.left(r) {
+            msg += &format!(", ~{left:.0} s left");
+        }
         match (&self.bar, self.mode) {
             (Some(bar), _) => {
                 bar.set_message(msg);
-                bar.set_position(match self.budget {
-                    Budget::Passes(_) => r.passes as u64,
-                    Budget::Seconds(_) => elapsed as u64,
+                bar.set_position(match (self.budget.end, self.budget.seconds) {
+                    (Some(_), _) => r.rendered as u64,
+                    (None, Some(_)) => elapsed as u64,
+                    (None, None) => r.passes as u64,
                 });
             }
-            (None, Mode::Plain) => eprintln!("{msg}"),
+            (None, Mode::Plain) => {
+                // A line every few seconds: logs stay readable at any pass rate.
+                let now = std::time::Instant::now();
+                if self.last_line.get().is_none_or(|t| now.duration_since(t).as_secs_f64() >= 2.0) {
+                    eprintln!("{msg}");
+                    self.last_line.set(Some(now));
+                }
+            }
             _ => {}
         }
     }

@@ -33,7 +33,7 @@ fn progressive_photon_mapping_is_thread_independent() {
     let settings =
         Settings { photons: 10_000, caustic_photons: 10_000, spp: 1, width: 40, height: 40, ..Settings::default() };
     check_thread_independence(|seed| {
-        render_progressive(&scene, &Settings { seed, ..settings }, Budget::Passes(3), |_| {}).0
+        render_progressive(&scene, &Settings { seed, ..settings }, Budget::passes(3), |_| {}).0
     });
 }
 

@@ -42,7 +42,7 @@ fn glossy_room() -> Scene {
 /// -10.7% against 12 such passes; with them -4.2%, and -3.2% against 48.)
 fn path_traced(scene: &Scene, size: u32) -> Film {
     let s = Settings { method: Method::Path, spp: 16, width: size, height: size, seed: 11, ..Settings::default() };
-    render_progressive(scene, &s, Budget::Passes(24), |_| {}).0
+    render_progressive(scene, &s, Budget::passes(24), |_| {}).0
 }
 
 #[test]

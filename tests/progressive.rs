@@ -14,7 +14,7 @@ fn progressive(passes: u32) -> photonmap::metrics::Metrics {
     let settings =
         Settings { photons: 50_000, caustic_photons: 50_000, spp: 1, width: 200, height: 200, ..Settings::default() };
     let mut seen = 0;
-    let (film, stats) = render_progressive(&scene, &settings, Budget::Passes(passes), |r| {
+    let (film, stats) = render_progressive(&scene, &settings, Budget::passes(passes), |r| {
         seen += 1;
         assert_eq!(r.passes, seen);
         assert!(r.film.pixels.iter().all(|c| c.is_finite()));

@@ -7,7 +7,9 @@ use photonmap::error::Error;
 use photonmap::film::ToneMap;
 use photonmap::integrator::whitted::Whitted;
 use photonmap::memory::available_memory;
-use photonmap::output::{check_writable, write};
+use photonmap::output::{check_writable, same_file, write_with, Extras};
+use photonmap::progress::Mode;
+use photonmap::provenance::SceneId;
 use photonmap::scene::Scene;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -22,20 +24,44 @@ struct Cli {
     /// The scene file (TOML).
     scene: PathBuf,
     /// Output image: .png or .ppm (8-bit, colours clamped to [0, 1]) or
-    /// .exr (linear float).
+    /// .exr (linear float, with how it was made in its header).
     out: PathBuf,
     /// Bounce depth: reflections stop after this many (0: none).
     #[arg(default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=1000))]
     depth: u32,
+    /// Image width in pixels [default: the scene file's]. A size of another
+    /// shape than the camera's widens a look-at camera's view; a
+    /// four-corner camera's plane must have the image's shape.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    width: Option<u32>,
+    /// Image height in pixels [default: the scene file's].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    height: Option<u32>,
+    /// Jittered samples per pixel (stratified when a square) [default:
+    /// rays_per_pixel_edge squared from the scene file].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    spp: Option<u32>,
+    /// Worker threads [default: all cores].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    threads: Option<u32>,
     /// Seed of the pixel jitter.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = parse_seed)]
     seed: u64,
-    /// No summary line.
+    /// No progress bar and no summary.
     #[arg(short, long)]
     quiet: bool,
 }
 
+fn parse_seed(s: &str) -> Result<u64, String> {
+    s.trim().parse::<u64>().map_err(|_| format!("'{s}' must be a whole number from 0 to {}", u64::MAX))
+}
+
 fn main() -> ExitCode {
+    // Ctrl-C stops at once, and leaves no half-written file behind.
+    let _ = ctrlc::set_handler(|| {
+        photonmap::output::remove_temporaries();
+        std::process::exit(130);
+    });
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -46,11 +72,30 @@ fn main() -> ExitCode {
 }
 
 fn run(cli: Cli) -> Result<(), Error> {
+    let start = Instant::now();
     check_writable(&cli.out)?;
+    if let Some(threads) = cli.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads as usize)
+            .build_global()
+            .map_err(|e| Error::Invalid(format!("--threads: {e}")))?;
+    }
     let file = photonmap::scene::file::load(&cli.scene).map_err(|e| Error::Invalid(e.to_string()))?;
+    let id = SceneId::from_files(&cli.scene, &file.meshes).map_err(|e| Error::Io { path: cli.scene.clone(), source: e })?;
+    for input in &id.inputs {
+        if same_file(&cli.out, input) {
+            return Err(Error::Invalid(format!(
+                "{}: the output is also an input of the scene; it would be overwritten (choose another name)",
+                cli.out.display()
+            )));
+        }
+    }
     let n = file.rays_per_pixel_edge;
-    let scene = Scene::from_parts(file.parts);
-    let (w, h) = (scene.camera.width, scene.camera.height);
+    let mut scene = Scene::from_parts(file.parts);
+    let load_time = start.elapsed();
+    let (w, h) = (cli.width.unwrap_or(scene.camera.width), cli.height.unwrap_or(scene.camera.height));
+    scene.camera = scene.camera.fit(w, h).map_err(|e| Error::Invalid(format!("{}: {e}", cli.scene.display())))?;
+    let spp = cli.spp.unwrap_or(n * n);
     // The film (12 bytes a pixel) and its 8-bit copy must fit.
     let need = w as u64 * h as u64 * 16;
     if available_memory().is_some_and(|available| need > available) {
@@ -60,20 +105,36 @@ fn run(cli: Cli) -> Result<(), Error> {
             need as f64 / 1e9
         )));
     }
-    let start = Instant::now();
-    let film = Whitted { scene: &scene, max_depth: cli.depth }.render(w, h, n, cli.seed);
-    let elapsed = start.elapsed();
-    write(&cli.out, &film, ToneMap::Clamp, 1.0)?;
+    let t = Instant::now();
+    let film = Whitted { scene: &scene, max_depth: cli.depth }.render(w, h, spp, cli.seed, Mode::detect(cli.quiet));
+    let render_time = t.elapsed();
+    let attributes = [
+        ("scene", id.name.clone()),
+        ("scene_sha256", id.hash.clone()),
+        ("integrator", "whitted".to_string()),
+        ("seed", cli.seed.to_string()),
+        ("spp", spp.to_string()),
+        ("depth", cli.depth.to_string()),
+        ("wall_seconds", format!("{:.3}", start.elapsed().as_secs_f64())),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect();
+    let t = Instant::now();
+    write_with(&cli.out, &film, ToneMap::Clamp, 1.0, &Extras { attributes, layers: Vec::new() })?;
+    let write_time = t.elapsed();
     if !cli.quiet {
+        let threads = rayon::current_num_threads();
+        eprintln!("trace: Whitted, {w} x {h}, {spp} spp, depth {}, {threads} threads", cli.depth);
         eprintln!(
-            "trace: {} x {}, {n} x {n} rays per pixel, depth {}, {} primitives, {} lights: {:.3} s",
-            w,
-            h,
-            cli.depth,
+            "  scene load   {:>8.3} s  {} primitives, {} lights",
+            load_time.as_secs_f64(),
             scene.prim_count(),
-            scene.lights.len(),
-            elapsed.as_secs_f64()
+            scene.lights.len()
         );
+        eprintln!("  camera pass  {:>8.3} s", render_time.as_secs_f64());
+        eprintln!("  write        {:>8.3} s  {}", write_time.as_secs_f64(), cli.out.display());
+        eprintln!("  total        {:>8.3} s", start.elapsed().as_secs_f64());
     }
     Ok(())
 }

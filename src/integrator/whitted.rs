@@ -119,17 +119,11 @@ impl Whitted<'_> {
     }
 
     /// Renders the scene's camera at `width` x `height` on the shared
-    /// camera pass, each pixel the mean of an n x n grid of jittered
-    /// samples (n = `rays_per_pixel_edge`).
-    pub fn render(&self, width: u32, height: u32, rays_per_pixel_edge: u32, seed: u64) -> Film {
-        let pass = CameraPass {
-            camera: self.scene.camera.with_resolution(width, height),
-            spp: rays_per_pixel_edge * rays_per_pixel_edge,
-            edge_spp: 0,
-            seed,
-            pass: 0,
-        };
-        camera_pass(&pass, self, Mode::Quiet, &mut None).film
+    /// camera pass, each pixel the mean of `spp` jittered samples
+    /// (stratified when `spp` is a square: the course's n x n grid).
+    pub fn render(&self, width: u32, height: u32, spp: u32, seed: u64, progress: Mode) -> Film {
+        let pass = CameraPass { camera: self.scene.camera.with_resolution(width, height), spp, edge_spp: 0, seed, pass: 0 };
+        camera_pass(&pass, self, progress, &mut None).film
     }
 }
 

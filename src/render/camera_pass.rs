@@ -41,7 +41,8 @@ pub(crate) fn sample_index(pass: u64, pixel: u64) -> u64 {
 }
 
 /// Renders the film. The rim pixels are found once, by the probes of the
-/// first pass given an empty `rims`, and kept: they are a property of the
+/// first pass given an empty `rims` (with the same random streams whatever
+/// that pass is, so a render resumed at any pass finds the same), and kept: they are a property of the
 /// scene and the image, not of a pass's photons. Which pixels take the
 /// split estimate changes only its noise, not its mean. Found again every
 /// pass, the probes (four camera rays a pixel) were 16-24% of a
@@ -58,7 +59,7 @@ pub fn camera_pass<I: Integrator>(
     let mut counters = Counters::default();
     let rims: &[bool] = rims.get_or_insert_with(|| {
         if pass.edge_spp > 0 {
-            light_rims(camera, integrator, pass.seed, pass.pass, &mut counters)
+            light_rims(camera, integrator, pass.seed, &mut counters)
         } else {
             vec![false; w as usize * h as usize]
         }
@@ -73,6 +74,10 @@ pub fn camera_pass<I: Integrator>(
         .map_init(I::Thread::default, |thread, (row, out)| {
             let row = row as u32;
             let mut counters = Counters::default();
+            if crate::interrupt::requested() {
+                // The pass is abandoned: its rows need not be finished.
+                return counters;
+            }
             for (col, out) in (0..w).zip(out) {
                 let pixel = row as u64 * w as u64 + col as u64;
                 let mut rng = stream(pass.seed, Domain::Camera, sample_index(pass.pass, pixel));

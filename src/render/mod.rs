@@ -2,14 +2,16 @@
 //! → film. A classic render is one pass; a progressive render averages
 //! passes whose estimates narrow ([`progressive`]).
 
+pub mod accumulation;
 pub mod camera_pass;
+pub mod error_estimate;
 pub mod photon_stage;
 pub mod progressive;
 mod rims;
 
 pub use camera_pass::{camera_pass, CameraPass};
 pub use photon_stage::GLOBAL_GRID_CELL;
-pub use progressive::{render_progressive, Budget, PassReport};
+pub use progressive::{render_passes, render_progressive, Budget, PassReport, Run, Stopped};
 
 use crate::film::Film;
 use crate::integrator::path::PathIntegrator;

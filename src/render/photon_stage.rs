@@ -30,7 +30,7 @@ impl Estimates {
     /// Zwicker 2011), while each estimate keeps adapting to the local density.
     /// k stays at least 2 (the estimators use the k-1 photons inside the rim).
     pub fn progressive(scene: &Scene, settings: &Settings, pass: u32) -> Self {
-        let s: f64 = (1..=pass).map(|k| (k as f64 + settings.alpha as f64 - 1.0) / k as f64).product();
+        let s = shrink(settings.alpha, pass);
         let k = |k: usize| ((k as f64 * s).round() as usize).max(2);
         Estimates {
             k_global: k(settings.k_global),
@@ -39,6 +39,12 @@ impl Estimates {
             r_caustic: settings.r_caustic(scene) * s.sqrt() as f32,
         }
     }
+}
+
+/// Pass `pass`'s shrink factor s_i = prod_{k=1}^{i} (k + alpha - 1) / k:
+/// its estimates' k and squared radius caps relative to pass 0's.
+pub fn shrink(alpha: f32, pass: u32) -> f64 {
+    (1..=pass).map(|k| (k as f64 + alpha as f64 - 1.0) / k as f64).product()
 }
 
 /// The maps of one photon-mapping pass. The global map itself is dropped

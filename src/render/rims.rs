@@ -23,7 +23,6 @@ pub(super) fn light_rims<I: Integrator>(
     camera: &Camera,
     integrator: &I,
     seed: u64,
-    pass: u64,
     counters: &mut Counters,
 ) -> Vec<bool> {
     let (w, h) = (camera.width, camera.height);
@@ -39,7 +38,7 @@ pub(super) fn light_rims<I: Integrator>(
             let mut row_counters = Counters::default();
             for (col, count) in (0..w).zip(out) {
                 let pixel = row as u64 * w as u64 + col as u64;
-                let mut rng = stream(seed, Domain::EdgeProbes, sample_index(pass, pixel));
+                let mut rng = stream(seed, Domain::EdgeProbes, sample_index(0, pixel));
                 let mut state = I::Pixel::default();
                 let mut ctx = Context { rng: &mut rng, counters: &mut row_counters, pixel };
                 *count = (0..PROBES)

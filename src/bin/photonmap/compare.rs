@@ -3,7 +3,7 @@
 
 use photonmap::error::Error;
 use photonmap::metrics::{compare_images, diff_rgb8, Comparison, Region, Window};
-use photonmap::output::{check_writable, read_exr, write_rgb8_image};
+use photonmap::output::{check_writable, read_exr, same_file, write_rgb8_image};
 use std::path::PathBuf;
 
 /// Scores TEST against REF: RMSE, relMSE, means and the test's relative
@@ -76,14 +76,6 @@ pub fn run(args: Args) -> Result<(), Error> {
         print!("{}", table(&c, &args, diff_scale));
     }
     Ok(())
-}
-
-/// Whether two paths name the same existing file.
-pub fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
-    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    }
 }
 
 fn region_json(r: &Region) -> serde_json::Value {

@@ -4,9 +4,14 @@
 //! options, runs, and returns an exit code; errors are printed, never
 //! panicked.
 
+mod args;
 mod compare;
 mod export;
+mod info;
+mod merge;
+mod outputs;
 mod render;
+mod write;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -34,14 +39,38 @@ enum Command {
     Compare(compare::Args),
     /// Write the scene for another renderer (Mitsuba 3).
     Export(export::Args),
+    /// Add partial renders (--partial) into one image.
+    Merge(merge::Args),
+    /// Print how an EXR was made (its header) and a partial's parts.
+    Info(info::Args),
+}
+
+/// Ctrl-C (SIGINT) or SIGTERM: the first asks the render to stop (a
+/// progressive render writes the passes it has and exits 130); a second
+/// exits at once, removing any file half-written.
+fn handle_signals() {
+    let _ = ctrlc::set_handler(|| {
+        if photonmap::interrupt::requested() {
+            photonmap::output::remove_temporaries();
+            std::process::exit(130);
+        }
+        eprintln!("\nphotonmap: stopping (the passes finished are kept; Ctrl-C again to quit at once)");
+        photonmap::interrupt::request();
+    });
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    handle_signals();
     let result = match cli.command {
         Some(Command::Compare(args)) => compare::run(args),
         Some(Command::Export(args)) => export::run(args),
-        None => render::run(cli.render),
+        Some(Command::Merge(args)) => merge::run(args),
+        Some(Command::Info(args)) => info::run(args),
+        None => render::run(cli.render).map(|outcome| match outcome {
+            render::Outcome::Done => (),
+            render::Outcome::Interrupted => std::process::exit(130),
+        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

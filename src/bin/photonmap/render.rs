@@ -1,22 +1,30 @@
-//! Rendering: the default command. Parses and checks the options, loads
-//! the scene, renders (classic or progressive), writes, summarises.
+//! Rendering: the default command. Parses and checks the options and every
+//! output, loads the scene, renders (classic, progressive, a range of
+//! passes, or on from a partial), writes, summarises.
 
-use clap::ValueEnum;
+use crate::args::*;
+use crate::outputs::Outputs;
+use crate::write::{provenance, write_outputs, Written};
+use photonmap::display::Tev;
 use photonmap::error::Error;
-use photonmap::film::ToneMap;
+use photonmap::interrupt;
 use photonmap::memory::available_memory;
-use photonmap::metrics::compare;
-use photonmap::output::{check_writable, read_exr, write};
+use photonmap::metrics::{compare, reduction_factor, Window};
+use photonmap::output::partial::{read_partial, Manifest, Part, Partial};
+use photonmap::output::read_exr;
 use photonmap::progress::{Mode, PassDisplay};
-use photonmap::render::{render, render_progressive, Budget};
+use photonmap::provenance::{method_name, settings_key, SceneId};
+use photonmap::render::accumulation::{parse_range, Accumulation};
+use photonmap::render::{render, render_passes, Budget, Stopped};
 use photonmap::scene::{Eye, Scene};
-use photonmap::settings::{Method, Settings, DEFAULT};
+use photonmap::settings::{Method, Settings, DEFAULT, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP};
 use photonmap::stats::Summary;
+use std::ops::ControlFlow;
 use std::path::PathBuf;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// The estimator (`--integrator`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 enum IntegratorArg {
     /// Photon mapping: direct light, caustic map, final gathering.
     Photon,
@@ -24,19 +32,9 @@ enum IntegratorArg {
     Path,
 }
 
-/// How 8-bit outputs are made from radiance (`--tonemap`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-enum ToneMapArg {
-    /// Exposure from the image (its log-average luminance to middle grey),
-    /// then the sRGB curve.
-    Display,
-    /// v * 255.99 / i_max, i_max the largest channel value (the course's).
-    Linear,
-    /// sqrt(v) * 255.99 / sqrt(i_max): for scenes with bright spots.
-    Sqrt,
-    /// v * 255.99 clamped: 1.0 is white (the Whitted course's colours).
-    Clamp,
-}
+/// Outputs of a progressive render are rewritten this often, so a run
+/// that dies keeps an image (and a partial) of its passes so far.
+const REWRITE_SECONDS: f64 = 10.0;
 
 /// Rendering (the default command).
 #[derive(clap::Args, Debug)]
@@ -47,7 +45,9 @@ pub struct RenderArgs {
     #[arg(long, value_name = "SCENE.toml", conflicts_with = "eye")]
     scene: Option<PathBuf>,
     /// Output images; the extension picks the format: .exr (linear float
-    /// radiance), .png or .ppm (8-bit, tone-mapped).
+    /// radiance, with how it was made in its header, and for progressive
+    /// renders the error estimate's layers), .png or .ppm (8-bit,
+    /// tone-mapped).
     #[arg(value_name = "OUT")]
     outputs: Vec<PathBuf>,
     /// More output images (repeatable), as for OUT.
@@ -57,35 +57,71 @@ pub struct RenderArgs {
     /// next-event estimation, unbiased: the reference).
     #[arg(long, value_enum, default_value_t = IntegratorArg::Photon)]
     integrator: IntegratorArg,
-    /// Progressive rendering: this many independent passes, averaged; photon
-    /// mapping narrows its estimates (fewer photons each, smaller radius
-    /// caps) from pass to pass so the image converges to the true one.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000_000), conflicts_with = "time")]
+    /// Progressive rendering: passes 0 to N-1, averaged (with --resume:
+    /// until the image holds N passes). Photon mapping narrows its
+    /// estimates from pass to pass so the image converges to the true one.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000_000))]
     passes: Option<u32>,
-    /// Progressive rendering until this many seconds have passed (no pass
-    /// starts that would end later; at least one runs). The output is
-    /// rewritten every few passes, so stopping early keeps a valid image.
+    /// Progressive rendering for this many seconds (no pass starts that
+    /// would end later; at least one runs). Outputs are rewritten every 10
+    /// s, so stopping early keeps a valid image. With --passes or
+    /// --target-error, a cap.
     #[arg(long, value_parser = parse_seconds)]
     time: Option<f64>,
+    /// Progressive rendering until the predicted relative RMSE (of every
+    /// --window, or of the whole image) is below this (0.02: 2%); checked
+    /// from the fourth pass on. --time caps it.
+    #[arg(long, value_name = "E", value_parser = parse_target)]
+    target_error: Option<f64>,
+    /// A rectangle of pixels whose predicted error is reported (and, with
+    /// --target-error, aimed at), as [NAME=]ROW0:ROW1,COL0:COL1 (half-open,
+    /// row 0 at the top); repeatable.
+    #[arg(long = "window", value_name = "[NAME=]R0:R1,C0:C1")]
+    windows: Vec<String>,
+    /// Render only passes A to B-1 of a progressive render ("A..B"; "A.."
+    /// with --time or --target-error) and write them as a partial render
+    /// (--partial), for `photonmap merge`.
+    #[arg(long, value_name = "A..B", requires = "partial")]
+    pass_range: Option<String>,
+    /// Also write the progressive render's exact sums and a manifest to
+    /// this EXR (a partial render): what `merge` adds and `--resume` goes
+    /// on from. Rewritten with the outputs, and written on Ctrl-C.
+    #[arg(long, value_name = "PART.exr")]
+    partial: Option<PathBuf>,
+    /// Go on with the progressive render in this partial (same scene and
+    /// settings), from the pass after its last; --passes counts the passes
+    /// in the image, --time this run's seconds. --partial may name the same
+    /// file: it is replaced, atomically, by the longer render.
+    #[arg(long, value_name = "PART.exr", conflicts_with = "pass_range")]
+    resume: Option<PathBuf>,
+    /// Write a heat map of the per-pixel predicted error (progressive).
+    #[arg(long, value_name = "FILE.png")]
+    error_map: Option<PathBuf>,
+    /// Show each progressive pass in the tev image viewer listening at
+    /// HOST:PORT (tev's default: 127.0.0.1:14158).
+    #[arg(long, value_name = "HOST:PORT")]
+    display: Option<String>,
     /// How fast progressive photon mapping narrows its estimates (Knaus &
     /// Zwicker's alpha): pass i uses k and squared radius caps times
     /// prod_{j<i} (j + alpha - 1) / j.
     #[arg(long, default_value_t = DEFAULT.alpha, value_parser = parse_alpha)]
     alpha: f32,
-    /// Photons emitted for the global map, per pass (1e6, 2.5e5 and 1000000 all work).
-    #[arg(long, default_value = "1e6", value_parser = parse_count)]
-    photons: u64,
+    /// Photons emitted for the global map, per pass (1e6, 2.5e5 and 1000000
+    /// all work) [default: 1e6; 2.5e5 for progressive renders].
+    #[arg(long, value_parser = parse_count)]
+    photons: Option<u64>,
     /// Photons emitted towards mirrors and glass for the caustic map
     /// [default: the same as --photons].
     #[arg(long, value_parser = parse_count)]
     caustic_photons: Option<u64>,
     /// Jittered camera samples per pixel (stratified when a square)
-    /// [default: 4, or rays_per_pixel_edge squared from a scene file].
+    /// [default: 4, or rays_per_pixel_edge squared from a scene file; 1 for
+    /// progressive renders].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     spp: Option<u32>,
     /// Seed of every random stream: the same seed gives the same image on any
     /// number of threads.
-    #[arg(long, default_value_t = DEFAULT.seed)]
+    #[arg(long, default_value_t = DEFAULT.seed, value_parser = parse_seed)]
     seed: u64,
     /// Eye position: 1 = (-2,0,0), 53 degree view; 2 = (-1,0,0), 90 degrees.
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2))]
@@ -93,8 +129,9 @@ pub struct RenderArgs {
     /// Worker threads [default: all cores].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     threads: Option<u32>,
-    /// Image width in pixels; the image plane stays the camera's [default:
-    /// 800, or the scene file's].
+    /// Image width in pixels [default: 800, or the scene file's]. A size of
+    /// another shape than the camera's widens a look-at camera's view; a
+    /// four-corner camera's plane must have the image's shape.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     width: Option<u32>,
     /// Image height in pixels [default: 800, or the scene file's].
@@ -150,7 +187,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 1.0, value_parser = parse_exposure)]
     exposure: f32,
     /// Score the render against a reference EXR of the default scene (the
-    /// metric of shared/refs/metrics.py) and print the numbers.
+    /// metric of tools/metrics.py) and print the numbers.
     #[arg(long, value_name = "REF.exr")]
     reference: Option<PathBuf>,
     /// No progress bars and no summary.
@@ -158,79 +195,65 @@ pub struct RenderArgs {
     quiet: bool,
 }
 
-/// A photon count: an integer written plainly or in e-notation.
-fn parse_count(s: &str) -> Result<u64, String> {
-    let v: f64 = s.trim().parse().map_err(|_| format!("'{s}' is not a number (try 1e6 or 250000)"))?;
-    if !v.is_finite() || v < 0.0 {
-        return Err(format!("'{s}' must be zero or a positive count"));
-    }
-    if v.fract() != 0.0 {
-        return Err(format!("'{s}' is not a whole number of photons"));
-    }
-    // Photon indices are 32-bit in the kd-tree; beyond this the maps would
-    // not fit in memory on any machine this runs on anyway.
-    const MAX: f64 = 1e9;
-    if v > MAX {
-        return Err(format!("'{s}' is more than the 1e9 photons a map can hold"));
-    }
-    Ok(v as u64)
+/// How a render ended.
+pub enum Outcome {
+    Done,
+    /// Stopped by SIGINT/SIGTERM (what it had is written): exit 130.
+    Interrupted,
 }
 
-fn parse_radius(s: &str) -> Result<f32, String> {
-    match s.parse::<f32>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("'{s}' must be a positive distance")),
-    }
+/// The passes this run renders, and from what.
+struct Plan {
+    start: Accumulation,
+    first: u32,
+    budget: Budget,
+    /// The parts already in `start` (resumed).
+    parts: Vec<Part>,
 }
 
-fn parse_fraction(s: &str) -> Result<f32, String> {
-    match s.parse::<f32>() {
-        Ok(v) if (0.0..=1.0).contains(&v) => Ok(v),
-        _ => Err(format!("'{s}' must be a number from 0 to 1")),
-    }
-}
-
-fn parse_seconds(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 && v < 1e7 => Ok(v),
-        _ => Err(format!("'{s}' must be a positive number of seconds")),
-    }
-}
-
-fn parse_alpha(s: &str) -> Result<f32, String> {
-    match s.parse::<f32>() {
-        Ok(v) if v > 0.0 && v < 1.0 => Ok(v),
-        _ => Err(format!("'{s}' must lie strictly between 0 and 1")),
-    }
-}
-
-fn parse_exposure(s: &str) -> Result<f32, String> {
-    match s.parse::<f32>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("'{s}' must be a positive factor")),
-    }
-}
-
-pub fn run(cli: RenderArgs) -> Result<(), Error> {
+pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
     let start = Instant::now();
-    let outputs: Vec<PathBuf> = cli.outputs.iter().chain(&cli.more_outputs).cloned().collect();
+    let outputs = Outputs {
+        images: cli.outputs.iter().chain(&cli.more_outputs).cloned().collect(),
+        partial: cli.partial.clone(),
+        error_map: cli.error_map.clone(),
+    };
     if outputs.is_empty() {
         return Err(Error::Invalid("no output file given (e.g. photonmap out.exr)".into()));
     }
-    // Every output path is checked before any time is spent rendering.
-    for path in &outputs {
-        check_writable(path)?;
+    let windows = parse_windows(&cli.windows).map_err(Error::Invalid)?;
+    let progressive = cli.passes.is_some()
+        || cli.time.is_some()
+        || cli.target_error.is_some()
+        || cli.pass_range.is_some()
+        || cli.resume.is_some();
+    if !progressive {
+        for (given, what) in [(cli.partial.is_some(), "--partial"), (cli.error_map.is_some(), "--error-map")] {
+            if given {
+                return Err(Error::Invalid(format!(
+                    "{what} needs a progressive render: give --passes, --time or --target-error"
+                )));
+            }
+        }
     }
+    // Every output is checked before any time is spent loading or rendering.
+    outputs.check_writable()?;
     let reference = cli.reference.as_deref().map(read_exr).transpose()?;
+    let resumed = cli.resume.as_deref().map(read_partial).transpose()?;
     if let Some(threads) = cli.threads {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads as usize)
             .build_global()
             .map_err(|e| Error::Invalid(format!("--threads: {e}")))?;
     }
+
     let loading = Instant::now();
-    let (scene, file_spp) = match &cli.scene {
-        None => (Scene::tncg15(if cli.eye == Some(2) { Eye::Two } else { Eye::One }), 4),
+    let (mut scene, file_spp, scene_id) = match &cli.scene {
+        None => {
+            let eye = if cli.eye == Some(2) { Eye::Two } else { Eye::One };
+            let name = format!("built-in TNCG15 room, eye {}", if eye == Eye::Two { 2 } else { 1 });
+            (Scene::tncg15(eye), 4, SceneId::built_in(&name))
+        }
         Some(path) => {
             let file = photonmap::scene::file::load(path).map_err(|e| Error::Invalid(e.to_string()))?;
             if !file.not_physical.is_empty() {
@@ -240,18 +263,31 @@ pub fn run(cli: RenderArgs) -> Result<(), Error> {
                     all.join("\n")
                 )));
             }
+            let id = SceneId::from_files(path, &file.meshes).map_err(|e| Error::Io { path: path.clone(), source: e })?;
             let n = file.rays_per_pixel_edge;
-            (Scene::from_parts(file.parts), n * n)
+            (Scene::from_parts(file.parts), n * n, id)
         }
     };
     let load_time = loading.elapsed();
-    let width = cli.width.unwrap_or(scene.camera.width);
-    let height = cli.height.unwrap_or(scene.camera.height);
-    let tonemap = match cli.tonemap {
-        ToneMapArg::Display => ToneMap::Display,
-        ToneMapArg::Linear => ToneMap::Linear,
-        ToneMapArg::Sqrt => ToneMap::Sqrt,
-        ToneMapArg::Clamp => ToneMap::Clamp,
+    let mut inputs: Vec<(&str, &std::path::Path)> = scene_id.inputs.iter().map(|p| ("scene input", p.as_path())).collect();
+    inputs.extend(cli.reference.as_deref().map(|p| ("--reference", p)));
+    inputs.extend(cli.resume.as_deref().map(|p| ("--resume partial", p)));
+    outputs.check_not_inputs(&inputs, cli.resume.as_deref())?;
+    if scene.lights.is_empty() {
+        return Err(Error::Invalid(format!(
+            "{}: the scene has no light (an emissive shape or a [[lights]] entry), so its image is black",
+            scene_id.name
+        )));
+    }
+
+    let (width, height) = match &resumed {
+        Some(p) => (cli.width.unwrap_or(p.manifest.width), cli.height.unwrap_or(p.manifest.height)),
+        None => (cli.width.unwrap_or(scene.camera.width), cli.height.unwrap_or(scene.camera.height)),
+    };
+    scene.camera = scene.camera.fit(width, height).map_err(|e| Error::Invalid(format!("{}: {e}", scene_id.name)))?;
+    let (photons, spp) = match progressive {
+        true => (cli.photons.unwrap_or(PROGRESSIVE_PHOTONS), cli.spp.unwrap_or(PROGRESSIVE_SPP)),
+        false => (cli.photons.unwrap_or(DEFAULT.photons), cli.spp.unwrap_or(file_spp)),
     };
     let settings = Settings {
         method: match cli.integrator {
@@ -259,9 +295,9 @@ pub fn run(cli: RenderArgs) -> Result<(), Error> {
             IntegratorArg::Path => Method::Path,
         },
         alpha: cli.alpha,
-        photons: cli.photons,
-        caustic_photons: cli.caustic_photons.unwrap_or(cli.photons),
-        spp: cli.spp.unwrap_or(file_spp),
+        photons,
+        caustic_photons: cli.caustic_photons.unwrap_or(photons),
+        spp,
         seed: cli.seed,
         width,
         height,
@@ -276,10 +312,23 @@ pub fn run(cli: RenderArgs) -> Result<(), Error> {
         caustic_reuse: cli.caustic_reuse,
         skip: !cli.no_skip,
     };
+    if let Some(reference) = &reference {
+        reduction_factor((width, height), (reference.width, reference.height)).map_err(|e| {
+            Error::Invalid(format!("--reference: a {width}x{height} render cannot be scored against it: {e}"))
+        })?;
+    }
+    for w in &windows {
+        if w.rows.1 > height || w.cols.1 > width {
+            return Err(Error::Invalid(format!(
+                "--window {}: rows {}:{} and columns {}:{} reach outside the {width}x{height} image",
+                w.name, w.rows.0, w.rows.1, w.cols.0, w.cols.1
+            )));
+        }
+    }
     // Refuse before allocating: a map that cannot fit would abort the
     // process half-way, after minutes of work.
     if let Some(available) = available_memory() {
-        let need = settings.estimated_peak_bytes();
+        let need = settings.estimated_peak_bytes(progressive);
         if need > available {
             return Err(Error::Invalid(format!(
                 "--photons {} / --caustic-photons {} at {}x{} need about {:.1} GB; {:.1} GB of memory is available",
@@ -292,61 +341,205 @@ pub fn run(cli: RenderArgs) -> Result<(), Error> {
             )));
         }
     }
-    if settings.photons == 0 && !cli.quiet {
-        eprintln!("photonmap: warning: --photons 0: no global map, so indirect light is missing");
-    }
-    if settings.caustic_photons == 0 && !cli.quiet {
-        eprintln!("photonmap: warning: no caustic photons: caustics are missing");
+    let manifest = Manifest {
+        program: format!("photonmap {}", env!("CARGO_PKG_VERSION")),
+        scene: scene_id.name.clone(),
+        scene_hash: scene_id.hash.clone(),
+        settings: settings_key(&settings),
+        width,
+        height,
+        method: method_name(settings.method).into(),
+        alpha: settings.alpha,
+        passes: String::new(),
+        parts: Vec::new(),
+    };
+    let plan = if progressive { Some(plan(&cli, &manifest, resumed, windows)?) } else { None };
+    if !cli.quiet {
+        if settings.photons == 0 {
+            eprintln!("photonmap: warning: --photons 0: no global map, so indirect light is missing");
+        }
+        if settings.caustic_photons == 0 {
+            eprintln!("photonmap: warning: no caustic photons: caustics are missing");
+        }
     }
     let mode = Mode::detect(cli.quiet);
-    let budget = match (cli.passes, cli.time) {
-        (Some(n), _) => Some(Budget::Passes(n)),
-        (None, Some(s)) => Some(Budget::Seconds(s)),
-        (None, None) => None,
-    };
-    let (film, stats) = match budget {
-        None => render(&scene, &settings, mode),
-        Some(budget) => {
-            let mut last_write = Instant::now();
-            let mut write_error = None;
-            let display = PassDisplay::new(mode, budget);
-            let result = render_progressive(&scene, &settings, budget, |report| {
-                display.update(report);
-                // Rewrite the outputs now and then (atomically), so a user who
-                // stops the run keeps an image of every pass so far.
-                if write_error.is_none() && last_write.elapsed().as_secs_f64() > 10.0 {
-                    for path in &outputs {
-                        if let Err(e) = write(path, report.film, tonemap, cli.exposure) {
-                            write_error = Some(e);
-                        }
-                    }
-                    last_write = Instant::now();
-                }
-            });
-            display.finish();
-            if let Some(e) = write_error {
-                return Err(e);
-            }
-            result
+    let tonemap = cli.tonemap.tonemap();
+
+    let Some(plan) = plan else {
+        // A classic render: one pass, no error estimate.
+        let (film, stats) = render(&scene, &settings, mode);
+        if interrupt::requested() {
+            eprintln!("photonmap: interrupted; a single-pass render has nothing to keep, nothing written");
+            return Ok(Outcome::Interrupted);
         }
+        let photons = stats.global_emitted + stats.caustic_emitted;
+        let attributes = provenance(&scene_id, &settings, "0..1".into(), photons, start.elapsed().as_secs_f64());
+        let written = Written { film: &film, error: None, attributes };
+        let t = Instant::now();
+        let files = write_outputs(&outputs, &written, None, tonemap, cli.exposure)?;
+        finish(&cli, &settings, &stats, load_time, t.elapsed(), start, &files, &film, reference.as_ref(), &[])?;
+        if !cli.quiet {
+            eprintln!("  error        none estimated (a single pass; a progressive render, e.g. --time 60, estimates it)");
+        }
+        return Ok(Outcome::Done);
     };
-    let t = Instant::now();
-    for path in &outputs {
-        write(path, &film, tonemap, cli.exposure)?;
+
+    let mut tev = match &cli.display {
+        Some(address) => Some(
+            Tev::connect(address, "photonmap", width, height)
+                .map_err(|e| Error::Invalid(format!("--display {address}: cannot reach tev: {e}")))?,
+        ),
+        None => None,
+    };
+    let mut last_write = Instant::now();
+    let mut write_error = None;
+    let display = PassDisplay::new(mode, plan.budget.clone(), plan.first);
+    let mut part = Part { passes: String::new(), photons: 0, seconds: 0.0 };
+    let partial_of = |acc: &Accumulation, part: &Part| Partial {
+        manifest: Manifest { parts: plan.parts.iter().cloned().chain([part.clone()]).collect(), ..manifest.clone() },
+        accumulation: acc.clone(),
+    };
+    let run = render_passes(&scene, &settings, plan.start.clone(), plan.first, &plan.budget, |report| {
+        display.update(report);
+        if let Some(t) = &mut tev {
+            if let Err(e) = t.update(report.film) {
+                eprintln!("photonmap: warning: --display: {e}; the render goes on without it");
+                tev = None;
+            }
+        }
+        if last_write.elapsed().as_secs_f64() > REWRITE_SECONDS {
+            part.passes = format!("{}..{}", plan.first, plan.first + report.rendered);
+            part.seconds = start.elapsed().as_secs_f64();
+            part.photons = report.photons;
+            let photons = plan.parts.iter().map(|p| p.photons).sum::<u64>() + part.photons;
+            let passes = report.accumulation.passes.to_string();
+            let attributes = provenance(&scene_id, &settings, passes, photons, part.seconds);
+            let written = Written { film: report.film, error: report.error, attributes };
+            let partial = outputs.partial.as_ref().map(|_| partial_of(report.accumulation, &part));
+            if let Err(e) = write_outputs(&outputs, &written, partial.as_ref(), tonemap, cli.exposure) {
+                // Said at once: the render stops rather than run on unsaved.
+                eprintln!("photonmap: error: {e}");
+                write_error = Some(e);
+                return ControlFlow::Break(());
+            }
+            last_write = Instant::now();
+        }
+        ControlFlow::Continue(())
+    });
+    display.finish();
+    if let Some(e) = write_error {
+        return Err(e);
     }
-    let write_time = t.elapsed();
+    let film = run.film();
+    let rendered = run.stats.passes;
+    part.passes = format!("{}..{}", plan.first, plan.first + rendered);
+    part.photons = run.stats.global_emitted + run.stats.caustic_emitted;
+    part.seconds = start.elapsed().as_secs_f64();
+    let photons = plan.parts.iter().map(|p| p.photons).sum::<u64>() + part.photons;
+    let attributes = provenance(&scene_id, &settings, run.accumulation.passes.to_string(), photons, part.seconds);
+    let written = Written { film: &film, error: run.error.as_ref(), attributes };
+    let t = Instant::now();
+    let files = if rendered == 0 && plan.start.passes.is_empty() {
+        Vec::new()
+    } else {
+        let partial = outputs.partial.as_ref().map(|_| partial_of(&run.accumulation, &part));
+        write_outputs(&outputs, &written, partial.as_ref(), tonemap, cli.exposure)?
+    };
+    finish(&cli, &settings, &run.stats, load_time, t.elapsed(), start, &files, &film, reference.as_ref(), &run.predictions)?;
+    if !cli.quiet {
+        let why = match run.stopped {
+            Stopped::Passes => "the passes asked for are done".to_string(),
+            Stopped::Time => "--time is up".to_string(),
+            Stopped::TargetError => "--target-error is reached".to_string(),
+            Stopped::Interrupted => "interrupted; the passes finished are written".to_string(),
+            Stopped::Caller => "an output could not be written".to_string(),
+        };
+        eprintln!("  stopped      {why} ({} passes in the image, {rendered} by this run)", run.accumulation.passes.count());
+    }
+    Ok(if run.stopped == Stopped::Interrupted { Outcome::Interrupted } else { Outcome::Done })
+}
+
+/// The progressive plan: where to start, when to stop.
+fn plan(cli: &RenderArgs, manifest: &Manifest, resumed: Option<Partial>, windows: Vec<Window>) -> Result<Plan, Error> {
+    let mut budget = Budget { end: cli.passes, seconds: cli.time, target_error: cli.target_error, windows, ..Budget::default() };
+    if let Some(text) = &cli.pass_range {
+        let (first, end) = match text.strip_suffix("..") {
+            Some(a) => (parse_range(a).map_err(|e| Error::Invalid(format!("--pass-range {e}")))?.start, None),
+            None => {
+                let r = parse_range(text).map_err(|e| Error::Invalid(format!("--pass-range {e}")))?;
+                (r.start, Some(r.end))
+            }
+        };
+        if end.is_none() && cli.time.is_none() && cli.target_error.is_none() {
+            return Err(Error::Invalid(format!(
+                "--pass-range {text}: an open range needs --time or --target-error to end it"
+            )));
+        }
+        if cli.passes.is_some() {
+            return Err(Error::Invalid("--pass-range gives the passes; --passes cannot be given with it".into()));
+        }
+        budget.end = end;
+        let start = Accumulation::new(manifest.width, manifest.height);
+        return Ok(Plan { start, first, budget, parts: Vec::new() });
+    }
+    if let Some(p) = resumed {
+        let path = cli.resume.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
+        if let Some(why) = p.manifest.mismatch(manifest) {
+            return Err(Error::Invalid(format!("--resume {path}: not this render's partial: {why}")));
+        }
+        let first = p.accumulation.passes.end();
+        if budget.end.is_some_and(|n| n <= first) {
+            return Err(Error::Invalid(format!(
+                "--resume {path}: it holds passes {} already; --passes {} asks for no more",
+                p.accumulation.passes,
+                budget.end.unwrap_or(0)
+            )));
+        }
+        return Ok(Plan { first, budget, parts: p.manifest.parts, start: p.accumulation });
+    }
+    if budget.end.is_none() && budget.seconds.is_none() && budget.target_error.is_none() {
+        return Err(Error::Invalid("a progressive render needs --passes, --time or --target-error".into()));
+    }
+    Ok(Plan { start: Accumulation::new(manifest.width, manifest.height), first: 0, budget, parts: Vec::new() })
+}
+
+/// The summary, the predicted error and the reference's scores.
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    cli: &RenderArgs,
+    settings: &Settings,
+    stats: &photonmap::stats::Stats,
+    load_time: Duration,
+    write_time: Duration,
+    start: Instant,
+    files: &[PathBuf],
+    film: &photonmap::film::Film,
+    reference: Option<&photonmap::film::Film>,
+    predictions: &[(String, photonmap::render::error_estimate::Prediction)],
+) -> Result<(), Error> {
     if !cli.quiet {
         let summary = Summary {
-            stats: &stats,
-            settings: &settings,
+            stats,
+            settings,
             threads: rayon::current_num_threads(),
             load_time,
             write_time,
             total_time: start.elapsed(),
-            written: &outputs,
+            written: files,
         };
         for line in summary.lines() {
             eprintln!("{line}");
+        }
+        for (i, (name, p)) in predictions.iter().enumerate() {
+            eprintln!(
+                "  {}  {name}: RMSE {:.5} ({:.2}% of its mean; noise {:.5}, bias {:.5}), relMSE {:.6}",
+                if i == 0 { "error      " } else { "           " },
+                p.rmse,
+                100.0 * p.relative_rmse(),
+                p.noise_rmse,
+                p.bias_rmse,
+                p.relmse
+            );
         }
     }
     if stats.camera.nonfinite > 0 {
@@ -359,7 +552,7 @@ pub fn run(cli: RenderArgs) -> Result<(), Error> {
         );
     }
     if let Some(reference) = reference {
-        let m = compare(&film, &reference).ok_or_else(|| {
+        let m = compare(film, reference).ok_or_else(|| {
             Error::Invalid(format!(
                 "--reference: a {}x{} image cannot be compared with a {}x{} reference",
                 film.width, film.height, reference.width, reference.height

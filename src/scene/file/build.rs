@@ -22,6 +22,7 @@ pub fn build(src: Source, def: FileDef) -> Result<SceneFile, SceneError> {
         shading_normals: Vec::new(),
         lights: Vec::new(),
         not_physical: Vec::new(),
+        meshes: Vec::new(),
         origins: super::Origins { path: src.path.to_path_buf(), ..Default::default() },
     }
     .build(def)
@@ -35,6 +36,7 @@ pub(super) struct Builder<'a> {
     pub(super) shading_normals: Vec<[Vec3; 3]>,
     pub(super) lights: Vec<LightSpec>,
     pub(super) not_physical: Vec<SceneError>,
+    pub(super) meshes: Vec<std::path::PathBuf>,
     pub(super) origins: super::Origins,
 }
 
@@ -179,7 +181,13 @@ impl Builder<'_> {
             ambient,
             camera,
         };
-        Ok(SceneFile { parts, origins: self.origins, rays_per_pixel_edge, not_physical: self.not_physical })
+        Ok(SceneFile {
+            parts,
+            origins: self.origins,
+            rays_per_pixel_edge,
+            not_physical: self.not_physical,
+            meshes: self.meshes,
+        })
     }
 
     /// Where the text at `span` is, as a [`super::Place`].

@@ -105,7 +105,7 @@ impl Builder<'_> {
             let lr = centre + right * w - true_up * h;
             let ul = centre - right * w + true_up * h;
             let ur = centre + right * w + true_up * h;
-            Camera::from_corners(eye, [lr, ll, ul, ur], width, height)
+            Camera::from_corners(eye, [lr, ll, ul, ur], width, height).widening()
         };
         Ok((camera, n))
     }

@@ -81,6 +81,8 @@ pub struct SceneFile {
     /// honour (ambient light, a falloff other than 1/d^2, a Phong material
     /// that creates energy), located.
     pub not_physical: Vec<SceneError>,
+    /// The OBJ files it reads.
+    pub meshes: Vec<PathBuf>,
 }
 
 /// Reads and checks a scene file. Relative OBJ paths are relative to the

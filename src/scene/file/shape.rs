@@ -144,6 +144,7 @@ impl Builder<'_> {
                 let m = self.transform(i, &d.transform)?;
                 let obj_path = self.src.path.parent().unwrap_or(Path::new(".")).join(file.value);
                 let mesh = load_obj(&obj_path).map_err(|e| self.src.error(file.span.clone(), file.field.clone(), e))?;
+                self.meshes.push(obj_path.clone());
                 let triangles: Vec<Triangle> = mesh
                     .triangles
                     .iter()

@@ -1,0 +1,78 @@
+//! `photonmap info FILE.exr...`: what an image is: its size, channels and
+//! how it was made (the header attributes photonmap writes), and for a
+//! partial render its manifest.
+
+use photonmap::error::Error;
+use photonmap::output::partial::Manifest;
+use photonmap::output::read_header;
+use std::path::PathBuf;
+
+/// Prints an EXR's size, channels and provenance (program, scene and its
+/// hash, integrator, seed, photons, passes, spp, wall time), and a partial
+/// render's parts.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[arg(required = true, value_name = "FILE.exr")]
+    files: Vec<PathBuf>,
+}
+
+pub fn run(args: Args) -> Result<(), Error> {
+    for (i, path) in args.files.iter().enumerate() {
+        let h = read_header(path)?;
+        if i > 0 {
+            println!();
+        }
+        println!("{}: {} x {}", path.display(), h.width, h.height);
+        println!("  channels   {}", channel_groups(&h.channels));
+        for (key, value) in &h.attributes {
+            if key == "manifest" {
+                continue;
+            }
+            println!("  {key:<16} {value}");
+        }
+        if let Some(json) = h.get("manifest") {
+            match serde_json::from_str::<Manifest>(json) {
+                Ok(m) => {
+                    println!("  partial render of {} ({}), passes {}", m.scene, &m.scene_hash[..m.scene_hash.len().min(12)], m.passes);
+                    println!("  settings   {}", m.settings);
+                    for p in &m.parts {
+                        println!("  part       passes {:<12} {:>14} photons {:>10.1} s", p.passes, p.photons, p.seconds);
+                    }
+                }
+                Err(e) => println!("  manifest   unreadable: {e}"),
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Channel names grouped by their layer: "R G B, error.{R,G,B}, sums.{00..35}".
+fn channel_groups(channels: &[String]) -> String {
+    let mut groups: Vec<(String, Vec<String>)> = Vec::new();
+    for c in channels {
+        let (layer, name) = match c.rsplit_once('.') {
+            Some((l, n)) => (l.to_string(), n.to_string()),
+            None => (String::new(), c.clone()),
+        };
+        match groups.iter_mut().find(|(l, _)| *l == layer) {
+            Some((_, names)) => names.push(name),
+            None => groups.push((layer, vec![name])),
+        }
+    }
+    groups
+        .iter()
+        .map(|(layer, names)| {
+            let list = if names.len() > 4 {
+                format!("{}..{} ({})", names[0], names[names.len() - 1], names.len())
+            } else {
+                names.join(",")
+            };
+            if layer.is_empty() {
+                list
+            } else {
+                format!("{layer}.{{{list}}}")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}

@@ -1,0 +1,63 @@
+//! The files a run writes: checked before any rendering (each can be
+//! created, none is an input, none is named twice), then written
+//! atomically, every one of them whatever happens to the others.
+
+use photonmap::error::Error;
+use photonmap::output::{check_writable, same_file};
+use std::path::{Path, PathBuf};
+
+/// Every output of a run, by role.
+#[derive(Debug, Default)]
+pub struct Outputs {
+    pub images: Vec<PathBuf>,
+    pub partial: Option<PathBuf>,
+    pub error_map: Option<PathBuf>,
+}
+
+impl Outputs {
+    pub fn all(&self) -> Vec<(&'static str, &Path)> {
+        let mut all: Vec<(&'static str, &Path)> = self.images.iter().map(|p| ("output", p.as_path())).collect();
+        all.extend(self.partial.as_deref().map(|p| ("--partial", p)));
+        all.extend(self.error_map.as_deref().map(|p| ("--error-map", p)));
+        all
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.images.is_empty() && self.partial.is_none()
+    }
+
+    /// Each output can be written and none is named twice.
+    pub fn check_writable(&self) -> Result<(), Error> {
+        let all = self.all();
+        for (i, (role, path)) in all.iter().enumerate() {
+            check_writable(path)?;
+            if let Some((other, _)) = all[..i].iter().find(|(_, p)| same_file(p, path)) {
+                return Err(Error::Invalid(format!(
+                    "{}: given twice (as {other} and as {role})",
+                    path.display()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// No output is one of `inputs` (role, path), except that `--partial`
+    /// may be the partial that `--resume` extends (it is replaced,
+    /// atomically, by one holding more passes).
+    pub fn check_not_inputs(&self, inputs: &[(&str, &Path)], resumed: Option<&Path>) -> Result<(), Error> {
+        for (role, path) in self.all() {
+            for (input_role, input) in inputs {
+                if same_file(path, input) {
+                    if role == "--partial" && resumed.is_some_and(|r| same_file(r, path)) {
+                        continue;
+                    }
+                    return Err(Error::Invalid(format!(
+                        "{}: the {role} is also the {input_role}; it would be overwritten (choose another name)",
+                        path.display()
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+}
