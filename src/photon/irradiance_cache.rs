@@ -176,7 +176,7 @@ impl IrradianceCache {
                         position: p.position().to_array(),
                         irradiance: e.to_array(),
                         normal: quantize_normal(n),
-                        reach2: (4.0 * est.r2).min(r_max * r_max),
+                        reach2: 4.0 * est.r2.min(r_max * r_max),
                     };
                     (point, r2)
                 },

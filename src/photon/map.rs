@@ -141,6 +141,9 @@ pub struct Gathered {
     /// Squared radius of the disk the estimate divides by.
     pub r2: f32,
     pub count: usize,
+    /// Squared distance of the nearest photon of another surface met by
+    /// the search (infinite if none).
+    pub other_r2: f32,
 }
 
 impl PhotonMap {
@@ -346,15 +349,21 @@ impl PhotonMap {
     }
 
     /// Finds the `k` nearest photons within `r_max` of `x` (fewer if fewer are
-    /// there) and leaves them in the scratch in index order; the estimates
-    /// keep those on a surface facing like `n`, and sum them in that order,
-    /// which does not depend on the radius searched (hence not on the
-    /// thread's previous query) nor on whether the grid or the tree found them.
-    /// The estimate's disk has the k-th photon on its rim, or radius `r_max`
-    /// when fewer than `k` were found (a fixed-radius estimate). Photons on
-    /// other surfaces (a wall in a corner) take part in fixing the radius but
-    /// add no flux: the disk is the surface's own.
-    fn gather(&self, x: Vec3, k: usize, r_max: f32, scratch: &mut Scratch) -> Gathered {
+    /// there) on a surface facing like `n`, and leaves them in the scratch
+    /// in index order; the estimates sum them in that order, which does not
+    /// depend on the radius searched (hence not on the thread's previous
+    /// query) nor on whether the grid or the tree found them. The
+    /// estimate's disk has the k-th photon on its rim, or radius `r_max`
+    /// when fewer than `k` were found (a fixed-radius estimate).
+    ///
+    /// Photons on other surfaces (a wall in a corner, the far side of a
+    /// thin wall) do not count towards k: where they outnumber the
+    /// surface's own by orders of magnitude (a sunlit outside wall behind
+    /// a room's wall), counting them shrank the disk until the room's side
+    /// had no photon in most estimates. Where they lie inside the disk the
+    /// estimate says so ([`Gathered::other_r2`]), for the coverage
+    /// correction.
+    fn gather(&self, x: Vec3, n: Vec3, k: usize, r_max: f32, scratch: &mut Scratch) -> Gathered {
         let r_max2 = r_max * r_max;
         let Scratch { buf, select, .. } = scratch;
         // Search a growing radius from the hint: the k nearest within the
@@ -363,6 +372,7 @@ impl PhotonMap {
         // photons near the answer only.
         let mut r2 = if k > 0 && scratch.hint_r2 > 0.0 { scratch.hint_r2.min(r_max2) } else { r_max2 };
         let (mut count, mut ordered);
+        let mut other_r2 = f32::INFINITY;
         // The radius is narrowed at most once (see `within`); from there
         // it only grows, so the loop ends.
         let mut may_narrow = k > 0;
@@ -375,6 +385,18 @@ impl PhotonMap {
                     continue;
                 }
             }
+            let mut kept = 0;
+            for j in 0..count {
+                let key = buf[j];
+                let (d2, i) = unpack(key);
+                if self.faces(i, n) {
+                    buf[kept] = key;
+                    kept += 1;
+                } else {
+                    other_r2 = other_r2.min(d2);
+                }
+            }
+            count = kept;
             if k > 0 && count >= k {
                 // Keys rank photons at equal distances (f32 squares do tie,
                 // a few times per million estimates) by index: the k-th key
@@ -405,11 +427,10 @@ impl PhotonMap {
         }
         scratch.found = count;
         scratch.hint_r2 = if r2 < r_max2 { r2 * 1.25 } else { r_max2 };
-        Gathered { r2, count }
+        Gathered { r2, count, other_r2 }
     }
 
-    /// Whether photon `i` lies on a surface facing like `n` (photons on
-    /// other surfaces help fix the radius but add no flux).
+    /// Whether photon `i` lies on a surface facing like `n`.
     #[inline]
     fn faces(&self, i: u32, n: Vec3) -> bool {
         self.photons[i as usize].surface_normal().dot(n) >= NORMAL_COSINE
@@ -428,22 +449,18 @@ impl PhotonMap {
     /// surface: an edge, a corner or a contact is within it, and part of
     /// the disk may lie off the surface (see [`IrradianceEstimate`]).
     pub fn irradiance_estimate(&self, x: Vec3, n: Vec3, k: usize, r_max: f32, buf: &mut Scratch) -> IrradianceEstimate {
-        let g = self.gather(x, k, r_max, buf);
+        let g = self.gather(x, n, k, r_max, buf);
         if g.count == 0 || !(g.r2 > 0.0) {
             return IrradianceEstimate { irradiance: Color::ZERO, r2: g.r2, other_surfaces: false };
         }
         let on_rim_excluded = g.r2 < r_max * r_max;
         let mut flux = Color::ZERO;
-        let mut other_surfaces = false;
         for (d2, i) in buf.buf[..buf.found].iter().map(|&key| unpack(key)) {
             if !on_rim_excluded || d2 < g.r2 {
-                if self.faces(i, n) {
-                    flux += self.photons[i as usize].flux();
-                } else {
-                    other_surfaces = true;
-                }
+                flux += self.photons[i as usize].flux();
             }
         }
+        let other_surfaces = if on_rim_excluded { g.other_r2 < g.r2 } else { g.other_r2 <= g.r2 };
         IrradianceEstimate { irradiance: flux / (PI * g.r2), r2: g.r2, other_surfaces }
     }
 
@@ -457,16 +474,14 @@ impl PhotonMap {
     /// The photons' share of [`Self::radiance_cone`], which any reflectance
     /// turns into radiance.
     pub fn cone_estimate(&self, x: Vec3, n: Vec3, k: usize, r_max: f32, buf: &mut Scratch) -> ConeEstimate {
-        let g = self.gather(x, k, r_max, buf);
+        let g = self.gather(x, n, k, r_max, buf);
         if g.count == 0 || !(g.r2 > 0.0) {
             return ConeEstimate { weighted_flux: Color::ZERO, r2: g.r2 };
         }
         let inv_r = 1.0 / g.r2.sqrt();
         let mut weighted_flux = Color::ZERO;
         for (d2, i) in buf.buf[..buf.found].iter().map(|&key| unpack(key)) {
-            if self.faces(i, n) {
-                weighted_flux += self.photons[i as usize].flux() * (1.0 - d2.sqrt() * inv_r).max(0.0);
-            }
+            weighted_flux += self.photons[i as usize].flux() * (1.0 - d2.sqrt() * inv_r).max(0.0);
         }
         ConeEstimate { weighted_flux, r2: g.r2 }
     }
