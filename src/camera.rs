@@ -58,8 +58,8 @@ impl Camera {
     pub fn fit(self, width: u32, height: u32) -> Result<Camera, String> {
         let plane = self.aspect();
         // Within half a pixel of the plane's shape: the rounding of a size.
-        let fits = (width as f32 - plane * height as f32).abs() <= 0.5
-            || (height as f32 - width as f32 / plane).abs() <= 0.5;
+        let fits =
+            (width as f32 - plane * height as f32).abs() <= 0.5 || (height as f32 - width as f32 / plane).abs() <= 0.5;
         if fits {
             return Ok(self.with_resolution(width, height));
         }
@@ -155,7 +155,8 @@ mod tests {
         let (_, across, down) = wide.plane();
         assert!((across.length() / down.length() - 2.0).abs() < 1e-5);
         // Pixels stay square: the same angle a pixel across and down.
-        let (a, b, c) = (wide.ray(200, 100, Vec2::ZERO), wide.ray(201, 100, Vec2::ZERO), wide.ray(200, 101, Vec2::ZERO));
+        let (a, b, c) =
+            (wide.ray(200, 100, Vec2::ZERO), wide.ray(201, 100, Vec2::ZERO), wide.ray(200, 101, Vec2::ZERO));
         let (h, v) = (a.dir.angle_between(b.dir), a.dir.angle_between(c.dir));
         assert!((h / v - 1.0).abs() < 1e-3, "{h} vs {v}");
         // The centre ray and the vertical field of view are unchanged.

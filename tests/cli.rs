@@ -53,7 +53,9 @@ fn the_same_seed_writes_the_same_files_on_1_and_3_threads() {
         .map(|threads| {
             let (exr, png) = (dir.join(format!("t{threads}.exr")), dir.join(format!("t{threads}.png")));
             let args = ["--photons", "2e4", "--width", "136", "--height", "136", "--spp", "1", "--quiet"];
-            let o = photonmap(&[&args[..], &["--threads", threads, exr.to_str().unwrap(), "-o", png.to_str().unwrap()]].concat());
+            let o = photonmap(
+                &[&args[..], &["--threads", threads, exr.to_str().unwrap(), "-o", png.to_str().unwrap()]].concat(),
+            );
             assert!(o.status.success(), "{}", stderr(&o));
             let film = photonmap::output::read_exr(&exr).unwrap();
             let bits = film.pixels.iter().flat_map(|c| c.to_array()).map(f32::to_bits).collect();

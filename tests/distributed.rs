@@ -99,7 +99,19 @@ fn merge_refuses_parts_that_do_not_belong_together() {
     refused(merge(&[&a, &k], &[]), &["k.exr", "settings differ"]);
     // Another image size.
     let big = dir.join("big.exr");
-    ok(&photonmap(&["--width", "40", "--height", "40", "--photons", "3e3", "--quiet", "--pass-range", "2..4", "--partial", s(&big)]));
+    ok(&photonmap(&[
+        "--width",
+        "40",
+        "--height",
+        "40",
+        "--photons",
+        "3e3",
+        "--quiet",
+        "--pass-range",
+        "2..4",
+        "--partial",
+        s(&big),
+    ]));
     refused(merge(&[&a, &big], &[]), &["big.exr", "image sizes differ", "32x32", "40x40"]);
     // Another scene: a scene file.
     let scene_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
@@ -165,7 +177,9 @@ fn resume_refuses_other_settings() {
     ok(&photonmap(&[SMALL, &["--passes", "2", "--partial", s(&part)]].concat()));
     let before = std::fs::read(&part).unwrap();
     let out = dir.join("out.exr");
-    let o = photonmap(&[SMALL, &["--passes", "4", "--seed", "3", "--resume", s(&part), "--partial", s(&part), s(&out)]].concat());
+    let o = photonmap(
+        &[SMALL, &["--passes", "4", "--seed", "3", "--resume", s(&part), "--partial", s(&part), s(&out)]].concat(),
+    );
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("part.exr") && err.contains("settings differ"), "{err}");

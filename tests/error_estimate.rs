@@ -60,16 +60,11 @@ fn disk_irradiance(rho: f64) -> f64 {
 fn coverage(method: Method) -> (f64, f64) {
     let file = photonmap::scene::file::parse(FLOOR, Path::new("floor.toml")).unwrap();
     let scene = Scene::from_parts(file.parts);
-    let settings = Settings {
-        method,
-        photons: 20_000,
-        caustic_photons: 0,
-        spp: 1,
-        width: 40,
-        height: 40,
-        ..Settings::default()
-    };
-    let run = render_passes(&scene, &settings, Accumulation::new(40, 40), 0, &Budget::passes(16), |_| ControlFlow::Continue(()));
+    let settings =
+        Settings { method, photons: 20_000, caustic_photons: 0, spp: 1, width: 40, height: 40, ..Settings::default() };
+    let run = render_passes(&scene, &settings, Accumulation::new(40, 40), 0, &Budget::passes(16), |_| {
+        ControlFlow::Continue(())
+    });
     let est = ErrorEstimate::new(&run.accumulation, bias_model(&settings)).expect("16 passes give an estimate");
     // What the EXR's `error` layer holds.
     let stated = est.error_film();
@@ -94,7 +89,10 @@ fn coverage(method: Method) -> (f64, f64) {
 fn the_per_pixel_error_covers_the_true_error_at_its_confidence() {
     for method in [Method::Path, Method::Photon] {
         let (fraction, rms_z) = coverage(method);
-        eprintln!("{method:?}: |error| <= 1.96 sigma in {:.1}% of pixels; RMS of error / sigma {rms_z:.3}", 100.0 * fraction);
+        eprintln!(
+            "{method:?}: |error| <= 1.96 sigma in {:.1}% of pixels; RMS of error / sigma {rms_z:.3}",
+            100.0 * fraction
+        );
         assert!((0.90..=0.99).contains(&fraction), "{method:?}: covered in {:.1}% of pixels", 100.0 * fraction);
         assert!((0.8..=1.25).contains(&rms_z), "{method:?}: error / sigma has RMS {rms_z}");
     }
@@ -104,11 +102,14 @@ fn the_per_pixel_error_covers_the_true_error_at_its_confidence() {
 #[test]
 fn a_looser_target_error_stops_sooner() {
     let scene = Scene::tncg15(photonmap::scene::Eye::One);
-    let settings = Settings { photons: 3_000, caustic_photons: 3_000, spp: 1, width: 32, height: 32, ..Settings::default() };
+    let settings =
+        Settings { photons: 3_000, caustic_photons: 3_000, spp: 1, width: 32, height: 32, ..Settings::default() };
     let window = Window { name: "all".into(), rows: (0, 32), cols: (0, 32) };
     let stop = |target: f64| {
-        let budget = Budget { end: Some(500), target_error: Some(target), windows: vec![window.clone()], ..Budget::default() };
-        let run = render_passes(&scene, &settings, Accumulation::new(32, 32), 0, &budget, |_| ControlFlow::Continue(()));
+        let budget =
+            Budget { end: Some(500), target_error: Some(target), windows: vec![window.clone()], ..Budget::default() };
+        let run =
+            render_passes(&scene, &settings, Accumulation::new(32, 32), 0, &budget, |_| ControlFlow::Continue(()));
         assert_eq!(run.stopped, Stopped::TargetError, "target {target}");
         let reached = run.predictions[1].1.relative_rmse();
         assert!(reached < target, "stopped at {reached} for target {target}");

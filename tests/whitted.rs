@@ -139,7 +139,11 @@ fn jittered_supersampling_averages_an_edge() {
     let scene = sphere_scene(SUN);
     let whitted = Whitted { scene: &scene, max_depth: 0 };
     let run = |threads| {
-        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| whitted.render(32, 32, 16, 7, photonmap::progress::Mode::Quiet))
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| whitted.render(32, 32, 16, 7, photonmap::progress::Mode::Quiet))
     };
     let film = run(1);
     let partial = film.pixels.iter().filter(|c| c.x > 0.01 && c.x < 0.3).count();

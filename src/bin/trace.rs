@@ -81,7 +81,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             .map_err(|e| Error::Invalid(format!("--threads: {e}")))?;
     }
     let file = photonmap::scene::file::load(&cli.scene).map_err(|e| Error::Invalid(e.to_string()))?;
-    let id = SceneId::from_files(&cli.scene, &file.meshes).map_err(|e| Error::Io { path: cli.scene.clone(), source: e })?;
+    let id =
+        SceneId::from_files(&cli.scene, &file.meshes).map_err(|e| Error::Io { path: cli.scene.clone(), source: e })?;
     for input in &id.inputs {
         if same_file(&cli.out, input) {
             return Err(Error::Invalid(format!(

@@ -122,7 +122,8 @@ impl Whitted<'_> {
     /// camera pass, each pixel the mean of `spp` jittered samples
     /// (stratified when `spp` is a square: the course's n x n grid).
     pub fn render(&self, width: u32, height: u32, spp: u32, seed: u64, progress: Mode) -> Film {
-        let pass = CameraPass { camera: self.scene.camera.with_resolution(width, height), spp, edge_spp: 0, seed, pass: 0 };
+        let pass =
+            CameraPass { camera: self.scene.camera.with_resolution(width, height), spp, edge_spp: 0, seed, pass: 0 };
         camera_pass(&pass, self, progress, &mut None).film
     }
 }

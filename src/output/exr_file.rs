@@ -25,7 +25,11 @@ fn encode_error(path: &Path, e: exr::error::Error) -> Error {
 fn rgb_channels(prefix: &str, film: &Film) -> [(String, Samples); 3] {
     let channel = |c: usize| film.pixels.iter().map(|p| p.to_array()[c]).collect::<Vec<f32>>();
     let name = |c: &str| if prefix.is_empty() { c.to_string() } else { format!("{prefix}.{c}") };
-    [(name("R"), Samples::F32(channel(0))), (name("G"), Samples::F32(channel(1))), (name("B"), Samples::F32(channel(2)))]
+    [
+        (name("R"), Samples::F32(channel(0))),
+        (name("G"), Samples::F32(channel(1))),
+        (name("B"), Samples::F32(channel(2))),
+    ]
 }
 
 /// The image, `extras`' layers and attributes.
@@ -117,7 +121,8 @@ impl Header {
 pub fn read_header(path: &Path) -> Result<Header> {
     let meta = exr::meta::MetaData::read_from_file(path, false)
         .map_err(|e| Error::Decode { path: path.to_owned(), message: e.to_string() })?;
-    let header = meta.headers.first().ok_or_else(|| Error::Decode { path: path.to_owned(), message: "no image".into() })?;
+    let header =
+        meta.headers.first().ok_or_else(|| Error::Decode { path: path.to_owned(), message: "no image".into() })?;
     let size = header.layer_size;
     let mut attributes = Vec::new();
     if let Some(software) = &header.own_attributes.software_name {

@@ -116,9 +116,7 @@ pub fn write_with(path: &Path, film: &Film, tonemap: ToneMap, exposure: f32, ext
     let format = check_writable(path)?;
     atomically(path, |tmp| match format {
         Format::Exr => exr_file::write(tmp, film, extras),
-        Format::Png | Format::Ppm => {
-            encode_rgb8(tmp, film.width, film.height, film.to_rgb8(tonemap, exposure), format)
-        }
+        Format::Png | Format::Ppm => encode_rgb8(tmp, film.width, film.height, film.to_rgb8(tonemap, exposure), format),
     })
 }
 
@@ -204,7 +202,8 @@ fn encode_rgb8(tmp: &Path, width: u32, height: u32, rgb: Vec<u8>, format: Format
                 .map_err(|e| Error::Io { path: tmp.to_owned(), source: e })
         }
         _ => {
-            let buf = image::RgbImage::from_raw(width, height, rgb).ok_or_else(|| fail("image size mismatch".into()))?;
+            let buf =
+                image::RgbImage::from_raw(width, height, rgb).ok_or_else(|| fail("image size mismatch".into()))?;
             buf.save_with_format(tmp, image::ImageFormat::Png).map_err(|e| fail(e.to_string()))
         }
     }

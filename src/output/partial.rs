@@ -59,11 +59,11 @@ impl Manifest {
             return differs("the programs", &self.program, &other.program);
         }
         if self.scene_hash != other.scene_hash {
-            return differs("the scenes", &format!("{} ({})", self.scene, short(&self.scene_hash)), &format!(
-                "{} ({})",
-                other.scene,
-                short(&other.scene_hash)
-            ));
+            return differs(
+                "the scenes",
+                &format!("{} ({})", self.scene, short(&self.scene_hash)),
+                &format!("{} ({})", other.scene, short(&other.scene_hash)),
+            );
         }
         if (self.width, self.height) != (other.width, other.height) {
             return differs(
@@ -116,9 +116,9 @@ pub fn write_partial(path: &Path, partial: &Partial) -> Result<()> {
 pub fn read_partial(path: &Path) -> Result<Partial> {
     let bad = |message: String| Error::Decode { path: path.to_owned(), message };
     let (header, channels) = read_channels(path)?;
-    let json = header
-        .get("manifest")
-        .ok_or_else(|| bad("not a partial render (no photonmap.manifest attribute; write one with --partial)".into()))?;
+    let json = header.get("manifest").ok_or_else(|| {
+        bad("not a partial render (no photonmap.manifest attribute; write one with --partial)".into())
+    })?;
     let manifest: Manifest = serde_json::from_str(json).map_err(|e| bad(format!("its manifest: {e}")))?;
     if (manifest.width, manifest.height) != (header.width, header.height) {
         return Err(bad(format!(
@@ -130,7 +130,8 @@ pub fn read_partial(path: &Path) -> Result<Partial> {
     let n = header.width as usize * header.height as usize;
     let mut words: Vec<Option<Vec<u32>>> = vec![None; WORDS];
     for (name, samples) in channels {
-        if let (Some(w), Samples::U32(v)) = (name.strip_prefix("sums.").and_then(|w| w.parse::<usize>().ok()), samples) {
+        if let (Some(w), Samples::U32(v)) = (name.strip_prefix("sums.").and_then(|w| w.parse::<usize>().ok()), samples)
+        {
             if w < WORDS && v.len() == n {
                 words[w] = Some(v);
             }

@@ -72,7 +72,8 @@ impl PixelSums {
     }
 
     pub fn from_words(words: &[u32; 36]) -> PixelSums {
-        let v = |k: usize| -> i128 { (0..4).fold(0u128, |acc, w| acc | (words[4 * k + w] as u128) << (32 * w)) as i128 };
+        let v =
+            |k: usize| -> i128 { (0..4).fold(0u128, |acc, w| acc | (words[4 * k + w] as u128) << (32 * w)) as i128 };
         PixelSums { x: [v(0), v(1), v(2)], xx: [v(3), v(4), v(5)], sx: [v(6), v(7), v(8)] }
     }
 }

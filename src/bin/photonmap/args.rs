@@ -100,5 +100,10 @@ pub fn parse_target(s: &str) -> Result<f64, String> {
 }
 
 pub fn parse_windows(texts: &[String]) -> Result<Vec<Window>, String> {
-    texts.iter().enumerate().map(|(i, w)| Window::parse(w, i)).collect::<Result<_, _>>().map_err(|e| format!("--window: {e}"))
+    texts
+        .iter()
+        .enumerate()
+        .map(|(i, w)| Window::parse(w, i))
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("--window: {e}"))
 }

@@ -1,9 +1,9 @@
 //! `photonmap export --mitsuba [SCENE.toml] OUT.xml`: the scene written for
 //! Mitsuba 3 (photonmap::export::mitsuba), its meshes beside it.
 
-use photonmap::output::same_file;
 use photonmap::error::Error;
 use photonmap::export::mitsuba::to_mitsuba;
+use photonmap::output::same_file;
 use photonmap::output::write_bytes;
 use photonmap::scene::{Eye, Scene};
 use std::path::PathBuf;

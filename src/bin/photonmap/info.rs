@@ -33,10 +33,18 @@ pub fn run(args: Args) -> Result<(), Error> {
         if let Some(json) = h.get("manifest") {
             match serde_json::from_str::<Manifest>(json) {
                 Ok(m) => {
-                    println!("  partial render of {} ({}), passes {}", m.scene, &m.scene_hash[..m.scene_hash.len().min(12)], m.passes);
+                    println!(
+                        "  partial render of {} ({}), passes {}",
+                        m.scene,
+                        &m.scene_hash[..m.scene_hash.len().min(12)],
+                        m.passes
+                    );
                     println!("  settings   {}", m.settings);
                     for p in &m.parts {
-                        println!("  part       passes {:<12} {:>14} photons {:>10.1} s", p.passes, p.photons, p.seconds);
+                        println!(
+                            "  part       passes {:<12} {:>14} photons {:>10.1} s",
+                            p.passes, p.photons, p.seconds
+                        );
                     }
                 }
                 Err(e) => println!("  manifest   unreadable: {e}"),

@@ -49,7 +49,8 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<(), Error> {
     let start = Instant::now();
-    let outputs = Outputs { images: args.outputs.clone(), partial: args.partial.clone(), error_map: args.error_map.clone() };
+    let outputs =
+        Outputs { images: args.outputs.clone(), partial: args.partial.clone(), error_map: args.error_map.clone() };
     if outputs.is_empty() {
         return Err(Error::Invalid("merge: no output given (-o OUT.exr or --partial PART.exr)".into()));
     }
@@ -57,16 +58,16 @@ pub fn run(args: Args) -> Result<(), Error> {
     outputs.check_writable()?;
     let inputs: Vec<(&str, &std::path::Path)> = args.parts.iter().map(|p| ("partial merged", p.as_path())).collect();
     outputs.check_not_inputs(&inputs, None)?;
-    let parts: Vec<(String, Partial)> = args
-        .parts
-        .iter()
-        .map(|p| Ok((p.display().to_string(), read_partial(p)?)))
-        .collect::<Result<_, Error>>()?;
+    let parts: Vec<(String, Partial)> =
+        args.parts.iter().map(|p| Ok((p.display().to_string(), read_partial(p)?))).collect::<Result<_, Error>>()?;
     let merged = merge(&parts, args.allow_gaps)?;
     let m = &merged.manifest;
     for w in &windows {
         if w.rows.1 > m.height || w.cols.1 > m.width {
-            return Err(Error::Invalid(format!("--window {}: reaches outside the {}x{} image", w.name, m.width, m.height)));
+            return Err(Error::Invalid(format!(
+                "--window {}: reaches outside the {}x{} image",
+                w.name, m.width, m.height
+            )));
         }
     }
     let film = merged.accumulation.average();
@@ -90,7 +91,14 @@ pub fn run(args: Args) -> Result<(), Error> {
     let written = Written { film: &film, error: error.as_ref(), attributes };
     let files = write_outputs(&outputs, &written, Some(&merged), args.tonemap.tonemap(), args.exposure)?;
     if !args.quiet {
-        eprintln!("photonmap merge: {} parts, passes {} ({} in all), {}x{}", parts.len(), m.passes, merged.accumulation.passes.count(), m.width, m.height);
+        eprintln!(
+            "photonmap merge: {} parts, passes {} ({} in all), {}x{}",
+            parts.len(),
+            m.passes,
+            merged.accumulation.passes.count(),
+            m.width,
+            m.height
+        );
         eprintln!("  {:<40} {:>12} {:>14} {:>10}", "part", "passes", "photons", "seconds");
         for (name, p) in &parts {
             for part in &p.manifest.parts {
@@ -99,7 +107,13 @@ pub fn run(args: Args) -> Result<(), Error> {
         }
         eprintln!("  {:<40} {:>12} {:>14} {:>10.1}", "total", merged.accumulation.passes.count(), photons, seconds);
         for (name, p) in predict(error.as_ref(), &windows) {
-            eprintln!("  error {name}: RMSE {:.5} ({:.2}% of its mean; noise {:.5}, bias {:.5})", p.rmse, 100.0 * p.relative_rmse(), p.noise_rmse, p.bias_rmse);
+            eprintln!(
+                "  error {name}: RMSE {:.5} ({:.2}% of its mean; noise {:.5}, bias {:.5})",
+                p.rmse,
+                100.0 * p.relative_rmse(),
+                p.noise_rmse,
+                p.bias_rmse
+            );
         }
         for f in &files {
             eprintln!("  wrote {}", f.display());

@@ -32,10 +32,7 @@ impl Outputs {
         for (i, (role, path)) in all.iter().enumerate() {
             check_writable(path)?;
             if let Some((other, _)) = all[..i].iter().find(|(_, p)| same_file(p, path)) {
-                return Err(Error::Invalid(format!(
-                    "{}: given twice (as {other} and as {role})",
-                    path.display()
-                )));
+                return Err(Error::Invalid(format!("{}: given twice (as {other} and as {role})", path.display())));
             }
         }
         Ok(())

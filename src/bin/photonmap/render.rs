@@ -263,13 +263,15 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
                     all.join("\n")
                 )));
             }
-            let id = SceneId::from_files(path, &file.meshes).map_err(|e| Error::Io { path: path.clone(), source: e })?;
+            let id =
+                SceneId::from_files(path, &file.meshes).map_err(|e| Error::Io { path: path.clone(), source: e })?;
             let n = file.rays_per_pixel_edge;
             (Scene::from_parts(file.parts), n * n, id)
         }
     };
     let load_time = loading.elapsed();
-    let mut inputs: Vec<(&str, &std::path::Path)> = scene_id.inputs.iter().map(|p| ("scene input", p.as_path())).collect();
+    let mut inputs: Vec<(&str, &std::path::Path)> =
+        scene_id.inputs.iter().map(|p| ("scene input", p.as_path())).collect();
     inputs.extend(cli.reference.as_deref().map(|p| ("--reference", p)));
     inputs.extend(cli.resume.as_deref().map(|p| ("--resume partial", p)));
     outputs.check_not_inputs(&inputs, cli.resume.as_deref())?;
@@ -379,7 +381,9 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
         let files = write_outputs(&outputs, &written, None, tonemap, cli.exposure)?;
         finish(&cli, &settings, &stats, load_time, t.elapsed(), start, &files, &film, reference.as_ref(), &[])?;
         if !cli.quiet {
-            eprintln!("  error        none estimated (a single pass; a progressive render, e.g. --time 60, estimates it)");
+            eprintln!(
+                "  error        none estimated (a single pass; a progressive render, e.g. --time 60, estimates it)"
+            );
         }
         return Ok(Outcome::Done);
     };
@@ -445,7 +449,18 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
         let partial = outputs.partial.as_ref().map(|_| partial_of(&run.accumulation, &part));
         write_outputs(&outputs, &written, partial.as_ref(), tonemap, cli.exposure)?
     };
-    finish(&cli, &settings, &run.stats, load_time, t.elapsed(), start, &files, &film, reference.as_ref(), &run.predictions)?;
+    finish(
+        &cli,
+        &settings,
+        &run.stats,
+        load_time,
+        t.elapsed(),
+        start,
+        &files,
+        &film,
+        reference.as_ref(),
+        &run.predictions,
+    )?;
     if !cli.quiet {
         let why = match run.stopped {
             Stopped::Passes => "the passes asked for are done".to_string(),
@@ -454,14 +469,18 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
             Stopped::Interrupted => "interrupted; the passes finished are written".to_string(),
             Stopped::Caller => "an output could not be written".to_string(),
         };
-        eprintln!("  stopped      {why} ({} passes in the image, {rendered} by this run)", run.accumulation.passes.count());
+        eprintln!(
+            "  stopped      {why} ({} passes in the image, {rendered} by this run)",
+            run.accumulation.passes.count()
+        );
     }
     Ok(if run.stopped == Stopped::Interrupted { Outcome::Interrupted } else { Outcome::Done })
 }
 
 /// The progressive plan: where to start, when to stop.
 fn plan(cli: &RenderArgs, manifest: &Manifest, resumed: Option<Partial>, windows: Vec<Window>) -> Result<Plan, Error> {
-    let mut budget = Budget { end: cli.passes, seconds: cli.time, target_error: cli.target_error, windows, ..Budget::default() };
+    let mut budget =
+        Budget { end: cli.passes, seconds: cli.time, target_error: cli.target_error, windows, ..Budget::default() };
     if let Some(text) = &cli.pass_range {
         let (first, end) = match text.strip_suffix("..") {
             Some(a) => (parse_range(a).map_err(|e| Error::Invalid(format!("--pass-range {e}")))?.start, None),

@@ -22,7 +22,13 @@ pub struct Written<'a> {
 }
 
 /// The header attributes of a render of `scene` with `settings`.
-pub fn provenance(scene: &SceneId, settings: &Settings, passes: String, photons: u64, seconds: f64) -> Vec<(String, String)> {
+pub fn provenance(
+    scene: &SceneId,
+    settings: &Settings,
+    passes: String,
+    photons: u64,
+    seconds: f64,
+) -> Vec<(String, String)> {
     Provenance { scene, settings, passes, photons, seconds }.attributes()
 }
 
@@ -38,7 +44,8 @@ pub fn write_outputs(
     let mut extras = Extras { attributes: w.attributes.clone(), layers: Vec::new() };
     if let Some(e) = w.error {
         extras.attributes.push(("error_passes".into(), e.passes.to_string()));
-        extras.layers = vec![("error".into(), e.error_film()), ("noise".into(), e.noise_film()), ("bias".into(), e.bias_film())];
+        extras.layers =
+            vec![("error".into(), e.error_film()), ("noise".into(), e.noise_film()), ("bias".into(), e.bias_film())];
     }
     let mut written = Vec::new();
     let mut first_error = None;
@@ -57,7 +64,10 @@ pub fn write_outputs(
                 let (rgb, _) = heat_rgb8(&e.error_film(), None);
                 record(path, write_rgb8_image(path, w.film.width, w.film.height, rgb));
             }
-            None => eprintln!("photonmap: warning: --error-map {}: too few passes for an error estimate yet", path.display()),
+            None => eprintln!(
+                "photonmap: warning: --error-map {}: too few passes for an error estimate yet",
+                path.display()
+            ),
         }
     }
     if let (Some(path), Some(p)) = (&outputs.partial, partial) {
