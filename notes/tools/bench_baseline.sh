@@ -8,7 +8,7 @@
 # Compare on the same machine as the baseline, idle: the figures are wall times.
 # Both modes run the `floors` example first (and `save` again after the
 # benches): a shared box's speed moves by tens of percent from hour to hour,
-# and a bench that moved by as much as a random ray did is the box, not
+# and a bench that moved by as much as a random ray did is the machine, not
 # the code. `save` keeps its readings in notes/bench-baseline/floors.txt;
 # `compare` prints them beside the current ones.
 set -euo pipefail
@@ -28,7 +28,7 @@ case "$mode" in
       sed 's/^/  /' notes/bench-baseline/floors.txt
       a=$(ray_ns < notes/bench-baseline/floors.txt); b=$(echo "$now" | ray_ns)
       if [[ -n "$a" && -n "$b" ]]; then
-        awk -v a="$a" -v b="$b" 'BEGIN { printf "a random ray now takes %.2fx what it took then: read changes of that size as the box'"'"'s\n", b / a }'
+        awk -v a="$a" -v b="$b" 'BEGIN { printf "a random ray now takes %.2fx what it took then: read changes of that size as the machine'"'"'s\n", b / a }'
       fi
     fi
     (cd notes/bench-baseline && find . -type d -name committed) | while read -r d; do
@@ -48,7 +48,7 @@ case "$mode" in
       cp -r "target/criterion/$d/." "notes/bench-baseline/$d/"
     done
     { echo "$before"; echo "after the benches:"; echo "$after"; } > notes/bench-baseline/floors.txt
-    echo "floors before and after (notes/bench-baseline/floors.txt): a save is worth committing only if they agree with a calm box's"
+    echo "floors before and after (notes/bench-baseline/floors.txt): a save is worth committing only if they agree with a calm spell's"
     cat notes/bench-baseline/floors.txt
     ;;
   *) echo "usage: $0 compare|save [criterion args]" >&2; exit 2 ;;
