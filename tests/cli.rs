@@ -1,18 +1,9 @@
 //! The `photonmap` command: what a user types, what they get back.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{photonmap, scratch_dir};
 
-fn photonmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_photonmap")).args(args).output().expect("run photonmap")
-}
-
-fn scratch_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use std::process::Output;
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

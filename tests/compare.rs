@@ -1,22 +1,13 @@
 //! `photonmap compare`: known differences give known numbers through the
 //! command line, windows are scored, size rules hold, nothing is lost.
 
+mod common;
+use common::{photonmap, scratch_dir};
 use photonmap::film::Film;
 use photonmap::math::Color;
 use photonmap::output::write;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn photonmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_photonmap")).args(args).output().expect("run photonmap")
-}
-
-fn scratch_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use std::path::Path;
+use std::process::Output;
 
 fn exr(dir: &Path, name: &str, w: u32, h: u32, f: impl Fn(u32, u32) -> f32) -> String {
     let film = Film { width: w, height: h, pixels: (0..w * h).map(|i| Color::splat(f(i % w, i / w))).collect() };

@@ -5,22 +5,13 @@
 //! an uninterrupted run gives; parts that do not belong together are
 //! refused with the reason.
 
+mod common;
+use common::{photonmap, scratch_dir};
 use photonmap::output::partial::read_partial;
 use photonmap::output::read_exr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
-
-fn photonmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_photonmap")).args(args).output().expect("run photonmap")
-}
-
-fn scratch_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn ok(o: &Output) {
     assert!(o.status.success(), "exit {:?}: {}", o.status.code(), String::from_utf8_lossy(&o.stderr));

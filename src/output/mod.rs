@@ -42,16 +42,7 @@ pub fn check_writable(path: &Path) -> Result<Format> {
         path: path.to_owned(),
         source: std::io::Error::new(std::io::ErrorKind::PermissionDenied, message),
     };
-    let dir = parent_dir(path);
-    if !dir.is_dir() {
-        return Err(Error::Io {
-            path: path.to_owned(),
-            source: std::io::Error::new(
-                std::io::ErrorKind::NotFound,
-                format!("directory {} does not exist", dir.display()),
-            ),
-        });
-    }
+    let dir = existing_parent_dir(path)?;
     if let Ok(meta) = std::fs::metadata(path) {
         if meta.is_dir() {
             return Err(refuse("is a directory".into()));
@@ -87,6 +78,21 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
         (Some(a), Some(b)) => a == b,
         _ => false,
     }
+}
+
+/// The directory `path` would be written in, which must exist.
+fn existing_parent_dir(path: &Path) -> Result<PathBuf> {
+    let dir = parent_dir(path);
+    if dir.is_dir() {
+        return Ok(dir);
+    }
+    Err(Error::Io {
+        path: path.to_owned(),
+        source: std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            format!("directory {} does not exist", dir.display()),
+        ),
+    })
 }
 
 fn parent_dir(path: &Path) -> PathBuf {
@@ -133,16 +139,7 @@ pub fn write_rgb8_image(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> R
 /// Writes `bytes` to `path` atomically (any file: the exporter's XML and
 /// meshes).
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = parent_dir(path);
-    if !dir.is_dir() {
-        return Err(Error::Io {
-            path: path.to_owned(),
-            source: std::io::Error::new(
-                std::io::ErrorKind::NotFound,
-                format!("directory {} does not exist", dir.display()),
-            ),
-        });
-    }
+    existing_parent_dir(path)?;
     atomically(path, |tmp| std::fs::write(tmp, bytes).map_err(|e| Error::Io { path: path.to_owned(), source: e }))
 }
 

@@ -62,3 +62,16 @@ pub fn score_or_leave_evidence(name: &str, film: &Film, reference: &Film, ok: im
     }
     m
 }
+
+/// Runs the `photonmap` binary with `args`.
+pub fn photonmap(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_photonmap")).args(args).output().expect("run photonmap")
+}
+
+/// An empty directory of its own for test `name`.
+pub fn scratch_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
