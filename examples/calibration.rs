@@ -5,9 +5,12 @@
 //! after 4, 16, 64 and 200 passes, for the whole image and the caustic
 //! window.
 //!
-//! `cargo run --release --example calibration [-- --only NAME] [--passes N]`
-//! writes notes/calibration.csv and notes/calibration.svg (predicted against
-//! measured, log-log, the band of a factor 1.5 drawn).
+//! `cargo run --release --example calibration [-- --only NAME ...] [--passes N]`
+//! updates notes/calibration.csv after each scene (the rows of the scenes
+//! rendered are replaced, the others kept, so a long run can be done a few
+//! scenes at a time) and redraws notes/calibration.svg (predicted against
+//! measured, log-log, the band of a factor 1.5 drawn); `--replot` only
+//! redraws the plot from the CSV.
 
 use photonmap::metrics::compare_images;
 use photonmap::render::accumulation::Accumulation;
@@ -39,8 +42,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     photonmap::scene::procedural::write_suite_meshes(&root.join("scenes/suite/meshes"), true)?;
     let suite = photonmap::suite::load(&root.join("scenes/suite"))?;
-    let mut rows = Vec::new();
+    let notes = root.join("notes");
+    let mut rows = read_csv(&notes.join("calibration.csv"))?;
+    if args.iter().any(|a| a == "--replot") {
+        plot(&notes.join("calibration.svg"), &rows)?;
+        eprintln!("wrote notes/calibration.svg from {} rows", rows.len());
+        return Ok(());
+    }
     for s in suite.iter().filter(|s| only.is_empty() || only.contains(&&s.name)) {
+        let mut new_rows = Vec::new();
         let reference = s.load_reference()?;
         let info = s.reference_info();
         let file = photonmap::scene::file::load(&s.scene)?;
@@ -85,15 +95,51 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     row.measured,
                     row.predicted / row.measured
                 );
-                rows.push(row);
+                new_rows.push(row);
             }
             ControlFlow::Continue(())
         });
+        rows.retain(|r| r.scene != s.name);
+        rows.extend(new_rows);
+        rows.sort_by(|a, b| (&a.scene, a.passes, a.region != "image").cmp(&(&b.scene, b.passes, b.region != "image")));
+        write_csv(&notes.join("calibration.csv"), &rows)?;
+        plot(&notes.join("calibration.svg"), &rows)?;
+        eprintln!("updated notes/calibration.csv and notes/calibration.svg ({} rows)", rows.len());
     }
-    let notes = root.join("notes");
-    let mut csv = std::fs::File::create(notes.join("calibration.csv"))?;
+    Ok(())
+}
+
+fn read_csv(path: &Path) -> Result<Vec<Row>, Box<dyn std::error::Error>> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(e.into()),
+    };
+    let mut rows = Vec::new();
+    for line in text.lines().skip(1).filter(|l| !l.trim().is_empty()) {
+        let f: Vec<&str> = line.split(',').collect();
+        if f.len() < 8 {
+            return Err(format!("{}: short line {line:?}", path.display()).into());
+        }
+        rows.push(Row {
+            scene: f[0].to_string(),
+            region: if f[1] == "image" { "image" } else { "caustic" },
+            passes: f[2].parse()?,
+            seconds: f[3].parse()?,
+            predicted: f[4].parse()?,
+            predicted_noise: f[5].parse()?,
+            predicted_bias: f[6].parse()?,
+            measured: f[7].parse()?,
+        });
+    }
+    Ok(rows)
+}
+
+fn write_csv(path: &Path, rows: &[Row]) -> Result<(), Box<dyn std::error::Error>> {
+    let tmp = path.with_extension("csv.tmp");
+    let mut csv = std::fs::File::create(&tmp)?;
     writeln!(csv, "scene,region,passes,seconds,predicted_rmse,predicted_noise,predicted_bias,measured_rmse,ratio")?;
-    for r in &rows {
+    for r in rows {
         writeln!(
             csv,
             "{},{},{},{:.2},{:.6},{:.6},{:.6},{:.6},{:.3}",
@@ -108,8 +154,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             r.predicted / r.measured
         )?;
     }
-    plot(&notes.join("calibration.svg"), &rows)?;
-    eprintln!("wrote notes/calibration.csv and notes/calibration.svg");
+    drop(csv);
+    std::fs::rename(tmp, path)?;
     Ok(())
 }
 

@@ -56,6 +56,14 @@ impl Camera {
     /// the new aspect makes longer (the view only gains); a fixed plane of
     /// another aspect is refused, with the sizes that would fit.
     pub fn fit(self, width: u32, height: u32) -> Result<Camera, String> {
+        let fitted = self.fit_plane(width, height)?;
+        match fitted.precision_problem() {
+            Some(problem) => Err(problem),
+            None => Ok(fitted),
+        }
+    }
+
+    fn fit_plane(self, width: u32, height: u32) -> Result<Camera, String> {
         let plane = self.aspect();
         // Within half a pixel of the plane's shape: the rounding of a size.
         let fits =
@@ -84,6 +92,26 @@ impl Camera {
             c.down *= grow;
         }
         Ok(c.with_resolution(width, height))
+    }
+
+    /// Why single precision cannot render this view, if it cannot: a
+    /// pixel's ray direction is its plane point minus the eye, each rounded
+    /// to the size of the larger coordinate, so far from the origin
+    /// neighbouring pixels would get the same direction (an eye at 1e30
+    /// sees one colour).
+    pub fn precision_problem(&self) -> Option<String> {
+        let spacing = (self.across.length() / self.width as f32).min(self.down.length() / self.height as f32);
+        let corners = [self.upper_left, self.upper_left + self.across, self.upper_left + self.down];
+        let scale = corners.iter().fold(self.eye.abs().max_element(), |m, c| m.max(c.abs().max_element()));
+        // Rounding of half a pixel or more would move rays between pixels.
+        let rounding = scale * f32::EPSILON;
+        (!(spacing > 2.0 * rounding)).then(|| {
+            format!(
+                "the camera's coordinates (up to {scale:.3e}) are too large for single precision to tell its \
+                 pixels apart ({spacing:.3e} apart on the image plane, rounding {rounding:.3e}); move the \
+                 scene nearer the origin, or use fewer pixels"
+            )
+        })
     }
 
     /// The image plane: its top-left corner, and the vectors from there to
@@ -121,6 +149,16 @@ impl Camera {
 mod tests {
     use crate::scene::{Eye, Scene};
     use glam::{Vec2, Vec3};
+
+    #[test]
+    fn a_camera_far_from_the_origin_is_a_precision_problem() {
+        let cam = Scene::tncg15(Eye::One).camera;
+        assert!(cam.precision_problem().is_none());
+        assert!(cam.with_resolution(65536, 65536).precision_problem().is_none());
+        let far =
+            super::Camera { eye: cam.eye + Vec3::splat(1e7), upper_left: cam.upper_left + Vec3::splat(1e7), ..cam };
+        assert!(far.precision_problem().unwrap().contains("too large for single precision"));
+    }
 
     #[test]
     fn pixel_centres_follow_the_course_formula() {

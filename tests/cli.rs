@@ -86,6 +86,10 @@ fn bad_flags_fail_with_a_message_and_leave_the_output_alone() {
         (&["--width", "0", o], "width"),
         (&["--max-radius", "-1", o], "positive distance"),
         (&["--photons", "1e9", o], "memory is available"),
+        (&["--time", "1e30", o], "more than a week"),
+        (&["--time", "0", o], "positive"),
+        (&["--seed", "-1", o], "'-1' must be a whole number from 0 to 18446744073709551615"),
+        (&["--seed", "1e30", o], "must be a whole number from 0"),
         (&["--width", "65536", "--height", "65536", o], "memory is available"),
         (&[jpg.to_str().unwrap()], "unknown output extension"),
         (&[missing.to_str().unwrap()], "does not exist"),
@@ -97,6 +101,20 @@ fn bad_flags_fail_with_a_message_and_leave_the_output_alone() {
         assert!(stderr(&o).contains(message), "{args:?}: {}", stderr(&o));
     }
     assert_eq!(std::fs::read(&out).unwrap(), b"precious");
+}
+
+#[test]
+fn a_scene_without_lights_is_refused_with_that_reason() {
+    let dir = scratch_dir("cli-no-light");
+    let text = std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/tncg15.toml"))
+        .unwrap();
+    let scene = dir.join("dark.toml");
+    std::fs::write(&scene, &text[..text.find("[[lights]]").unwrap()]).unwrap();
+    let out = dir.join("dark.exr");
+    let o = photonmap(&["--scene", scene.to_str().unwrap(), out.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("dark.toml: the scene has no light"), "{}", stderr(&o));
+    assert!(!out.exists());
 }
 
 #[test]

@@ -86,12 +86,10 @@ fn existing_parent_dir(path: &Path) -> Result<PathBuf> {
     if dir.is_dir() {
         return Ok(dir);
     }
+    let why = if dir.exists() { "is not a directory" } else { "does not exist" };
     Err(Error::Io {
         path: path.to_owned(),
-        source: std::io::Error::new(
-            std::io::ErrorKind::NotFound,
-            format!("directory {} does not exist", dir.display()),
-        ),
+        source: std::io::Error::new(std::io::ErrorKind::NotFound, format!("directory {} {why}", dir.display())),
     })
 }
 

@@ -32,7 +32,12 @@ impl Outputs {
         for (i, (role, path)) in all.iter().enumerate() {
             check_writable(path)?;
             if let Some((other, _)) = all[..i].iter().find(|(_, p)| same_file(p, path)) {
-                return Err(Error::Invalid(format!("{}: given twice (as {other} and as {role})", path.display())));
+                let roles =
+                    if *other == *role { format!("twice as an {role}") } else { format!("as {other} and as {role}") };
+                return Err(Error::Invalid(format!(
+                    "{}: named {roles}; each output needs its own file",
+                    path.display()
+                )));
             }
         }
         Ok(())

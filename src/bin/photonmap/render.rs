@@ -270,8 +270,12 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
         }
     };
     let load_time = loading.elapsed();
-    let mut inputs: Vec<(&str, &std::path::Path)> =
-        scene_id.inputs.iter().map(|p| ("scene input", p.as_path())).collect();
+    let mut inputs: Vec<(&str, &std::path::Path)> = scene_id
+        .inputs
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (if i == 0 { "scene file" } else { "mesh" }, p.as_path()))
+        .collect();
     inputs.extend(cli.reference.as_deref().map(|p| ("--reference", p)));
     inputs.extend(cli.resume.as_deref().map(|p| ("--resume partial", p)));
     outputs.check_not_inputs(&inputs, cli.resume.as_deref())?;

@@ -51,6 +51,16 @@ pub(super) fn at<'v, T>(s: &'v Spanned<T>, field: String) -> At<'v, T> {
     At { value: s.get_ref(), span: s.span(), field }
 }
 
+/// The largest coordinate, colour or length a scene file may hold: beyond
+/// it, squared distances and sums of photon powers overflow single
+/// precision inside the renderer and light would vanish without a word.
+pub const LIMIT: f32 = 1e15;
+
+/// The most power (W) a scene's lights may emit in all: photon powers and
+/// pixel sums are accumulated in single precision (at most 3.4e38) and
+/// divided by small areas in density estimates.
+pub const MAX_POWER: f64 = 1e30;
+
 impl Builder<'_> {
     pub(super) fn fail<T>(&self, span: Range<usize>, field: &str, message: impl Into<String>) -> Result<T, SceneError> {
         Err(self.src.error(span, field, message))
@@ -60,6 +70,17 @@ impl Builder<'_> {
         let x = Vec3::from_array(*v.value);
         if !x.is_finite() {
             return self.fail(v.span.clone(), &v.field, format!("must be finite, got {x}"));
+        }
+        if x.abs().max_element() > LIMIT {
+            return self.fail(
+                v.span.clone(),
+                &v.field,
+                format!(
+                    "must be within ±{LIMIT:e} (larger values overflow single precision inside the renderer; \
+                     scale the scene or its light down), got [{:e}, {:e}, {:e}]",
+                    x.x, x.y, x.z
+                ),
+            );
         }
         Ok(x)
     }
@@ -79,13 +100,14 @@ impl Builder<'_> {
 
     pub(super) fn number(&self, v: &At<f32>, lo: f32, hi: f32, open_lo: bool) -> Result<f32, SceneError> {
         let x = *v.value;
+        let hi = hi.min(LIMIT);
         let ok = x.is_finite() && x <= hi && if open_lo { x > lo } else { x >= lo };
         if !ok {
-            let range = match (open_lo, hi.is_finite()) {
-                (true, false) => format!("must be > {lo}"),
-                (false, false) => format!("must be >= {lo}"),
-                (true, true) => format!("must be in ({lo}, {hi}]"),
-                (false, true) => format!("must be in [{lo}, {hi}]"),
+            let range = match (open_lo, hi == LIMIT) {
+                (true, true) => format!("must be > {lo} and at most {LIMIT:e}"),
+                (false, true) => format!("must be >= {lo} and at most {LIMIT:e}"),
+                (true, false) => format!("must be in ({lo}, {hi}]"),
+                (false, false) => format!("must be in [{lo}, {hi}]"),
             };
             return self.fail(v.span.clone(), &v.field, format!("{range}, got {x}"));
         }
@@ -173,6 +195,7 @@ impl Builder<'_> {
                  light itself (remove `ambient` or set it to [0, 0, 0])",
             ));
         }
+        self.check_power()?;
         let parts = SceneParts {
             prims: self.prims,
             shading_normals: self.shading_normals,
@@ -188,6 +211,45 @@ impl Builder<'_> {
             not_physical: self.not_physical,
             meshes: self.meshes,
         })
+    }
+
+    /// The lights' power, added in double precision, must stay below
+    /// [`MAX_POWER`]; the brightest light is named.
+    fn check_power(&self) -> Result<(), SceneError> {
+        let (mut lo, mut hi) = (glam::DVec3::splat(f64::MAX), glam::DVec3::splat(f64::MIN));
+        for p in &self.prims {
+            let (a, b) = p.shape.bounds();
+            lo = lo.min(a.as_dvec3());
+            hi = hi.max(b.as_dvec3());
+        }
+        let reach = if lo.x <= hi.x { 0.5 * (hi - lo).length() } else { 0.0 };
+        let pi = std::f64::consts::PI;
+        let powers: Vec<f64> = self
+            .lights
+            .iter()
+            .map(|l| match *l {
+                LightSpec::Area { surface, radiance, .. } => {
+                    pi * surface.area() as f64 * radiance.as_dvec3().max_element()
+                }
+                LightSpec::Point { intensity, .. } => 4.0 * pi * intensity.as_dvec3().max_element(),
+                LightSpec::Directional { irradiance, .. } => pi * reach * reach * irradiance.as_dvec3().max_element(),
+            })
+            .collect();
+        let total: f64 = powers.iter().sum();
+        if total.is_finite() && total <= MAX_POWER {
+            return Ok(());
+        }
+        let brightest = (0..powers.len()).max_by(|&a, &b| powers[a].total_cmp(&powers[b])).unwrap_or(0);
+        let place = self.origins.lights.get(brightest).cloned().unwrap_or_default();
+        Err(self.origins.error(
+            &place,
+            format!(
+                "emits {:.3e} W ({total:.3e} W from all lights), more than single precision carries through \
+                 photon and pixel sums (at most {MAX_POWER:e} W); lower its radiance and raise --exposure \
+                 instead (images are linear)",
+                powers[brightest]
+            ),
+        ))
     }
 
     /// Where the text at `span` is, as a [`super::Place`].

@@ -107,6 +107,9 @@ impl Builder<'_> {
             let ur = centre + right * w + true_up * h;
             Camera::from_corners(eye, [lr, ll, ul, ur], width, height).widening()
         };
+        if let Some(problem) = camera.precision_problem() {
+            return self.fail(d.eye.span(), &f("eye"), problem);
+        }
         Ok((camera, n))
     }
 
