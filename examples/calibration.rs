@@ -99,6 +99,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             ControlFlow::Continue(())
         });
+        // Re-read: another run may have updated other scenes meanwhile.
+        rows = read_csv(&notes.join("calibration.csv"))?;
         rows.retain(|r| r.scene != s.name);
         rows.extend(new_rows);
         rows.sort_by(|a, b| (&a.scene, a.passes, a.region != "image").cmp(&(&b.scene, b.passes, b.region != "image")));

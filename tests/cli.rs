@@ -39,7 +39,9 @@ fn renders_exr_png_and_ppm_in_one_run() {
 fn the_same_seed_writes_the_same_files_on_1_and_3_threads() {
     use photonmap::output::read_header;
     let dir = scratch_dir("cli-bytes");
-    let runs: Vec<(Vec<u32>, Vec<(String, String)>, Vec<u8>)> = ["1", "3"]
+    /// Pixel bits, header attributes, PNG bytes.
+    type Run = (Vec<u32>, Vec<(String, String)>, Vec<u8>);
+    let runs: Vec<Run> = ["1", "3"]
         .iter()
         .map(|threads| {
             let (exr, png) = (dir.join(format!("t{threads}.exr")), dir.join(format!("t{threads}.png")));
@@ -106,8 +108,8 @@ fn bad_flags_fail_with_a_message_and_leave_the_output_alone() {
 #[test]
 fn a_scene_without_lights_is_refused_with_that_reason() {
     let dir = scratch_dir("cli-no-light");
-    let text = std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/tncg15.toml"))
-        .unwrap();
+    let text =
+        std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/tncg15.toml")).unwrap();
     let scene = dir.join("dark.toml");
     std::fs::write(&scene, &text[..text.find("[[lights]]").unwrap()]).unwrap();
     let out = dir.join("dark.exr");

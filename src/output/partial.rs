@@ -1,18 +1,16 @@
 //! Partial renders: the exact sums of a set of progressive passes in an
 //! EXR, with a manifest that says what they are sums of. Its R, G, B
 //! channels hold the passes' average, so any viewer shows it; channels
-//! `sums.00` to `sums.35` hold the fixed-point sums as 32-bit words
+//! `sums.00` to `sums.47` hold the fixed-point sums as 32-bit words
 //! ([`crate::render::accumulation::PixelSums::words`]); the header
 //! attribute `photonmap.manifest` holds the manifest as JSON.
 
 use super::exr_file::{read_channels, write_channels, Samples};
 use super::{atomically, check_writable, Format};
 use crate::error::{Error, Result};
-use crate::render::accumulation::{Accumulation, PassSet, PixelSums};
+use crate::render::accumulation::{Accumulation, PassSet, PixelSums, WORDS};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
-
-const WORDS: usize = 36;
 
 /// What a partial's sums are sums of. Two partials merge only if every
 /// field but `passes` and `parts` is the same.

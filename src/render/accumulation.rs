@@ -5,8 +5,10 @@
 //! Floating-point sums would differ in their last bits with the grouping.
 //!
 //! Besides each pixel's sum, the sums the error estimate needs
-//! ([`super::error_estimate`]): of the squares, and of the values weighted
-//! by the pass's shrink factor (how far its estimates have narrowed).
+//! ([`super::error_estimate`]): of the squares, of the values weighted by
+//! the pass's shrink factor (how far its estimates have narrowed), and the
+//! first pass's value on its own (its widest estimates are the one pass
+//! the error estimate's line leaves out).
 
 use crate::film::Film;
 use crate::math::Color;
@@ -27,21 +29,29 @@ fn float(v: i128) -> f64 {
 }
 
 /// A pixel's sums over the passes included, per channel: of its values x,
-/// of x², and of s·x with s the pass's shrink factor.
+/// of x², and of s·x with s the pass's shrink factor; and pass 0's value
+/// x₀ (zero when pass 0 is not included).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PixelSums {
     pub x: [i128; 3],
     pub xx: [i128; 3],
     pub sx: [i128; 3],
+    pub first: [i128; 3],
 }
 
+/// The words a pixel's sums take in a file: 12 sums of 4 words.
+pub const WORDS: usize = 48;
+
 impl PixelSums {
-    fn add(&mut self, c: Color, shrink: f64) {
+    fn add(&mut self, c: Color, shrink: f64, first: bool) {
         for (i, v) in c.to_array().into_iter().enumerate() {
             let v = v as f64;
             self.x[i] = self.x[i].saturating_add(fixed(v));
             self.xx[i] = self.xx[i].saturating_add(fixed(v * v));
             self.sx[i] = self.sx[i].saturating_add(fixed(shrink * v));
+            if first {
+                self.first[i] = fixed(v);
+            }
         }
     }
 
@@ -50,19 +60,21 @@ impl PixelSums {
             self.x[i] = self.x[i].saturating_add(o.x[i]);
             self.xx[i] = self.xx[i].saturating_add(o.xx[i]);
             self.sx[i] = self.sx[i].saturating_add(o.sx[i]);
+            // At most one of the two holds pass 0: the other's is zero.
+            self.first[i] = self.first[i].saturating_add(o.first[i]);
         }
     }
 
-    /// The sums as floating point: (Σx, Σx², Σs·x) per channel.
-    pub fn to_f64(&self) -> [[f64; 3]; 3] {
-        [self.x.map(float), self.xx.map(float), self.sx.map(float)]
+    /// The sums as floating point: (Σx, Σx², Σs·x, x₀) per channel.
+    pub fn to_f64(&self) -> [[f64; 3]; 4] {
+        [self.x.map(float), self.xx.map(float), self.sx.map(float), self.first.map(float)]
     }
 
-    /// The nine sums as 36 little-endian 32-bit words (x, xx, sx; R, G, B;
-    /// lowest word first), for files.
-    pub fn words(&self) -> [u32; 36] {
-        let mut out = [0u32; 36];
-        for (k, v) in self.x.iter().chain(&self.xx).chain(&self.sx).enumerate() {
+    /// The twelve sums as 48 little-endian 32-bit words (x, xx, sx, first;
+    /// R, G, B; lowest word first), for files.
+    pub fn words(&self) -> [u32; WORDS] {
+        let mut out = [0u32; WORDS];
+        for (k, v) in self.x.iter().chain(&self.xx).chain(&self.sx).chain(&self.first).enumerate() {
             let bits = *v as u128;
             for w in 0..4 {
                 out[4 * k + w] = (bits >> (32 * w)) as u32;
@@ -71,10 +83,10 @@ impl PixelSums {
         out
     }
 
-    pub fn from_words(words: &[u32; 36]) -> PixelSums {
+    pub fn from_words(words: &[u32; WORDS]) -> PixelSums {
         let v =
             |k: usize| -> i128 { (0..4).fold(0u128, |acc, w| acc | (words[4 * k + w] as u128) << (32 * w)) as i128 };
-        PixelSums { x: [v(0), v(1), v(2)], xx: [v(3), v(4), v(5)], sx: [v(6), v(7), v(8)] }
+        PixelSums { x: [v(0), v(1), v(2)], xx: [v(3), v(4), v(5)], sx: [v(6), v(7), v(8)], first: [v(9), v(10), v(11)] }
     }
 }
 
@@ -191,7 +203,7 @@ impl Accumulation {
         assert_eq!((film.width, film.height), (self.width, self.height));
         self.passes.insert(pass..pass + 1)?;
         for (sums, c) in self.pixels.iter_mut().zip(&film.pixels) {
-            sums.add(*c, shrink);
+            sums.add(*c, shrink, pass == 0);
         }
         Ok(())
     }
@@ -286,10 +298,11 @@ mod tests {
     #[test]
     fn words_round_trip() {
         let mut s = PixelSums::default();
-        s.add(Color::new(1e6, 3.5e-12, 0.25), 0.7);
-        s.add(Color::new(2.0, 0.0, 1e9), 0.5);
+        s.add(Color::new(1e6, 3.5e-12, 0.25), 0.7, true);
+        s.add(Color::new(2.0, 0.0, 1e9), 0.5, false);
         assert_eq!(PixelSums::from_words(&s.words()), s);
         assert!((s.to_f64()[0][0] - 1_000_002.0).abs() < 1e-9);
+        assert_eq!(s.to_f64()[3][2], 0.25);
     }
 
     #[test]

@@ -5,8 +5,13 @@
 //! shrink factor s_i (its squared radius caps and k; a density estimate's
 //! bias is proportional to its squared radius, to first order). Per pixel
 //! and channel a least-squares line through the passes' values against
-//! s_i gives
-//! * the noise of the average: the residuals' variance over N;
+//! s_i, pass 0 left out, gives
+//! * the noise of the average: the residuals' variance over N, with pass
+//!   0's own distance from the line (less the line's uncertainty there)
+//!   counted as that pass's share. Pass 0's estimates are the widest, and
+//!   off the line: fitted with it, a blurred first pass, or one rare
+//!   bright photon in it, read as a steep slope, and the suite's bias
+//!   predictions came out 2-10 times the error measured;
 //! * its bias, B·s̄ (s̄ the mean shrink factor of the passes included), with
 //!   the slope's own sampling variance, so that B̂²s̄² minus that variance
 //!   estimates the squared bias without the noise's contribution.
@@ -90,57 +95,93 @@ impl Prediction {
 
 impl ErrorEstimate {
     /// The estimate from an accumulation of passes; `None` with too few
-    /// passes to tell noise from bias (three for photon mapping, two for
-    /// path tracing).
+    /// passes to tell noise from bias (four for photon mapping from pass 0,
+    /// three for other sets of passes, two for path tracing).
     pub fn new(acc: &Accumulation, model: BiasModel) -> Option<ErrorEstimate> {
         let n = acc.passes.count();
         let nf = n as f64;
-        let line = match model {
-            BiasModel::None => None,
-            BiasModel::Shrinking { alpha } => {
-                let (s, s2) = shrink_sums(&acc.passes, alpha);
-                let sss = s2 - s * s / nf;
-                // Passes with (nearly) the same shrink factor cannot tell
-                // the bias's slope: then no estimate.
-                if n < 3 || !(sss > 1e-9 * s2) {
-                    return None;
-                }
-                Some((s, sss))
+        let alpha = match model {
+            BiasModel::None => {
+                return (n >= 2).then(|| Self::unbiased(acc));
             }
+            BiasModel::Shrinking { alpha } => alpha,
         };
-        if n < 2 {
+        // The line is fitted to the passes after the first, whose widest
+        // estimates lie off it: on the suite, a first pass's blur (or one
+        // rare bright photon in it, where the line's slope reads it as
+        // bias) made the bias 2-10 times what was measured. The first
+        // pass's own distance from the line counts as its noise.
+        let skip_first = acc.passes.iter().next() == Some(0);
+        let (mut s, mut s2) = shrink_sums(&acc.passes, alpha);
+        let s_all = s / nf;
+        if skip_first {
+            s -= 1.0;
+            s2 -= 1.0;
+        }
+        let m = if skip_first { n - 1 } else { n };
+        let mf = m as f64;
+        let sss = s2 - s * s / mf;
+        // Passes with (nearly) the same shrink factor cannot tell the
+        // bias's slope, and a line needs a residual to measure noise.
+        if m < 3 || !(sss > 1e-9 * s2) {
             return None;
         }
+        let s_mean = s / mf;
+        // The variance of the line's value at the first pass (s = 1), per
+        // unit of noise variance.
+        let first_leverage = 1.0 / mf + (1.0 - s_mean).powi(2) / sss;
+        let mut est = Self::empty(acc);
+        for (i, sums) in acc.pixels.iter().enumerate() {
+            let [x, xx, sx, first] = sums.to_f64();
+            for c in 0..3 {
+                est.mean[i][c] = x[c] / nf;
+                let (x, xx, sx) = match skip_first {
+                    true => (x[c] - first[c], xx[c] - first[c] * first[c], sx[c] - first[c]),
+                    false => (x[c], xx[c], sx[c]),
+                };
+                let ss_xx = (xx - x * x / mf).max(0.0);
+                let sxs = sx - s * x / mf;
+                let slope = sxs / sss;
+                let var = (ss_xx - slope * sxs).max(0.0) / (mf - 2.0);
+                est.noise_var[i][c] = match skip_first {
+                    true => {
+                        let off = first[c] - (x / mf + slope * (1.0 - s_mean));
+                        (var * (nf - 1.0) + off * off - var * first_leverage) / (nf * nf)
+                    }
+                    false => var / nf,
+                };
+                est.bias[i][c] = slope * s_all;
+                est.bias_var[i][c] = var * s_all * s_all / sss;
+            }
+        }
+        Some(est)
+    }
+
+    /// Passes without bias: their spread over their count.
+    fn unbiased(acc: &Accumulation) -> ErrorEstimate {
+        let nf = acc.passes.count() as f64;
+        let mut est = Self::empty(acc);
+        for (i, sums) in acc.pixels.iter().enumerate() {
+            let [x, xx, _, _] = sums.to_f64();
+            for c in 0..3 {
+                est.mean[i][c] = x[c] / nf;
+                est.noise_var[i][c] = (xx[c] - x[c] * x[c] / nf).max(0.0) / (nf - 1.0) / nf;
+            }
+        }
+        est
+    }
+
+    fn empty(acc: &Accumulation) -> ErrorEstimate {
         let len = acc.pixels.len();
-        let mut est = ErrorEstimate {
+        ErrorEstimate {
             width: acc.width,
             height: acc.height,
-            passes: n,
+            passes: acc.passes.count(),
             noise_var: vec![[0.0; 3]; len],
             bias: vec![[0.0; 3]; len],
             bias_var: vec![[0.0; 3]; len],
             mean: vec![[0.0; 3]; len],
-        };
-        for (i, sums) in acc.pixels.iter().enumerate() {
-            let [x, xx, sx] = sums.to_f64();
-            for c in 0..3 {
-                let ss_xx = (xx[c] - x[c] * x[c] / nf).max(0.0);
-                est.mean[i][c] = x[c] / nf;
-                match line {
-                    None => est.noise_var[i][c] = ss_xx / (nf - 1.0) / nf,
-                    Some((s, sss)) => {
-                        let sxs = sx[c] - s * x[c] / nf;
-                        let slope = sxs / sss;
-                        let var = (ss_xx - slope * sxs).max(0.0) / (nf - 2.0);
-                        let s_mean = s / nf;
-                        est.noise_var[i][c] = var / nf;
-                        est.bias[i][c] = slope * s_mean;
-                        est.bias_var[i][c] = var * s_mean * s_mean / sss;
-                    }
-                }
-            }
         }
-        Some(est)
     }
 
     /// The predicted error of the pixels in `window` (all when `None`).
@@ -165,7 +206,7 @@ impl ErrorEstimate {
             }
         }
         let n = count.max(1) as f64;
-        let (noise, bias2) = (noise / n, (bias2 / n).max(0.0));
+        let (noise, bias2) = ((noise / n).max(0.0), (bias2 / n).max(0.0));
         Prediction {
             rmse: (noise + bias2).sqrt(),
             noise_rmse: noise.sqrt(),
@@ -177,7 +218,7 @@ impl ErrorEstimate {
 
     /// Per pixel: the standard error of the average's noise.
     pub fn noise_film(&self) -> Film {
-        self.film(|i, c| self.noise_var[i][c].sqrt())
+        self.film(|i, c| self.noise_var[i][c].max(0.0).sqrt())
     }
 
     /// Per pixel: the bias estimate (signed; noisy, see the module docs).
@@ -190,7 +231,7 @@ impl ErrorEstimate {
     pub fn error_film(&self) -> Film {
         self.film(|i, c| {
             let b2 = self.bias[i][c] * self.bias[i][c] - self.bias_var[i][c];
-            (self.noise_var[i][c] + b2.max(0.0)).sqrt()
+            (self.noise_var[i][c] + b2.max(0.0)).max(0.0).sqrt()
         })
     }
 

@@ -108,7 +108,7 @@ pub fn run(args: Args) -> Result<(), Error> {
         eprintln!("  {:<40} {:>12} {:>14} {:>10.1}", "total", merged.accumulation.passes.count(), photons, seconds);
         for (name, p) in predict(error.as_ref(), &windows) {
             eprintln!(
-                "  error {name}: RMSE {:.5} ({:.2}% of its mean; noise {:.5}, bias {:.5})",
+                "  error {name}: RMSE {:.5} ({:.2}% of mean; noise {:.5}, bias {:.5})",
                 p.rmse,
                 100.0 * p.relative_rmse(),
                 p.noise_rmse,

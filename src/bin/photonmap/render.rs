@@ -319,9 +319,8 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
         skip: !cli.no_skip,
     };
     if let Some(reference) = &reference {
-        reduction_factor((width, height), (reference.width, reference.height)).map_err(|e| {
-            Error::Invalid(format!("--reference: a {width}x{height} render cannot be scored against it: {e}"))
-        })?;
+        reduction_factor((width, height), (reference.width, reference.height))
+            .map_err(|e| Error::Invalid(format!("--reference: {e}")))?;
     }
     for w in &windows {
         if w.rows.1 > height || w.cols.1 > width {
@@ -483,8 +482,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
 
 /// The progressive plan: where to start, when to stop.
 fn plan(cli: &RenderArgs, manifest: &Manifest, resumed: Option<Partial>, windows: Vec<Window>) -> Result<Plan, Error> {
-    let mut budget =
-        Budget { end: cli.passes, seconds: cli.time, target_error: cli.target_error, windows, ..Budget::default() };
+    let mut budget = Budget { end: cli.passes, seconds: cli.time, target_error: cli.target_error, windows };
     if let Some(text) = &cli.pass_range {
         let (first, end) = match text.strip_suffix("..") {
             Some(a) => (parse_range(a).map_err(|e| Error::Invalid(format!("--pass-range {e}")))?.start, None),
@@ -555,7 +553,7 @@ fn finish(
         }
         for (i, (name, p)) in predictions.iter().enumerate() {
             eprintln!(
-                "  {}  {name}: RMSE {:.5} ({:.2}% of its mean; noise {:.5}, bias {:.5}), relMSE {:.6}",
+                "  {}  {name}: RMSE {:.5} ({:.2}% of mean; noise {:.5}, bias {:.5}), relMSE {:.6}",
                 if i == 0 { "error      " } else { "           " },
                 p.rmse,
                 100.0 * p.relative_rmse(),
