@@ -186,7 +186,12 @@ impl ErrorEstimate {
 
     /// The predicted error of the pixels in `window` (all when `None`).
     pub fn predict(&self, window: Option<&Window>) -> Prediction {
-        let (mut noise, mut bias2, mut rel, mut mean, mut count) = (0.0, 0.0, 0.0, 0.0, 0u64);
+        let (mut noise, mut bias2, mut mean, mut count) = (0.0, 0.0, 0.0, 0u64);
+        // relMSE weighs dark pixels most, where a few passes' noisy
+        // estimates of a pixel's noise (pass 0's term can be negative)
+        // would decide its sign: its noise part counts each pixel's at
+        // least zero.
+        let (mut rel_noise, mut rel_bias) = (0.0, 0.0);
         for row in 0..self.height {
             for col in 0..self.width {
                 if window.is_some_and(|w| !w.contains(row, col)) {
@@ -199,7 +204,8 @@ impl ErrorEstimate {
                     noise += self.noise_var[i][c];
                     bias2 += b2;
                     let m = self.mean[i][c];
-                    rel += (self.noise_var[i][c] + b2) / (m * m + 1e-2);
+                    rel_noise += self.noise_var[i][c].max(0.0) / (m * m + 1e-2);
+                    rel_bias += b2 / (m * m + 1e-2);
                     mean += m;
                     count += 1;
                 }
@@ -211,7 +217,7 @@ impl ErrorEstimate {
             rmse: (noise + bias2).sqrt(),
             noise_rmse: noise.sqrt(),
             bias_rmse: bias2.sqrt(),
-            relmse: (rel / n).max(0.0),
+            relmse: rel_noise / n + (rel_bias / n).max(0.0),
             mean: mean / n,
         }
     }
