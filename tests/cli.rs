@@ -105,6 +105,41 @@ fn bad_flags_fail_with_a_message_and_leave_the_output_alone() {
     assert_eq!(std::fs::read(&out).unwrap(), b"precious");
 }
 
+/// The summary says how long the scene took to load and which files were
+/// written, in lines that fit 100 columns; `trace`'s too.
+#[test]
+fn the_summary_names_loading_and_the_files_written_within_100_columns() {
+    let dir = scratch_dir("cli-summary");
+    let (exr, png) = (dir.join("summary.exr"), dir.join("summary.png"));
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/suite/02-cornell.toml");
+    for extra in [&["--passes", "4", "--window", "caustic=0:8,0:8"][..], &[][..]] {
+        let mut args = vec!["--scene", scene.to_str().unwrap(), "--width", "32", "--height", "32"];
+        args.extend(["--photons", "2e3", exr.to_str().unwrap(), "-o", png.to_str().unwrap()]);
+        args.extend(extra);
+        let o = photonmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = stderr(&o);
+        let summary: Vec<&str> = text.split(['\n', '\r']).filter(|l| !l.is_empty()).collect();
+        for line in &summary {
+            assert!(line.chars().count() <= 100, "{} columns: {line}", line.chars().count());
+        }
+        assert!(summary.iter().any(|l| l.trim_start().starts_with("scene load")), "{text}");
+        for file in [&exr, &png] {
+            assert!(summary.iter().any(|l| l.contains(file.to_str().unwrap())), "{} not named: {text}", file.display());
+        }
+    }
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/whitted-spheres.toml");
+    let out = dir.join("trace.png");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_trace"))
+        .args([scene.to_str().unwrap(), out.to_str().unwrap(), "--width", "32", "--height", "32"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stderr(&o);
+    assert!(text.lines().all(|l| l.chars().count() <= 100), "{text}");
+    assert!(text.contains("scene load") && text.contains(out.to_str().unwrap()), "{text}");
+}
+
 #[test]
 fn a_scene_without_lights_is_refused_with_that_reason() {
     let dir = scratch_dir("cli-no-light");
@@ -186,6 +221,7 @@ fn help_documents_every_option_with_its_default() {
         "--cache-stride",
         "--edge-spp",
         "--tonemap",
+        "- clamp:",
         "--exposure",
         "--reference",
         "--quiet",
