@@ -48,7 +48,7 @@ case "$mode" in
       cp -r "target/criterion/$d/." "notes/bench-baseline/$d/"
     done
     { echo "$before"; echo "after the benches:"; echo "$after"; } > notes/bench-baseline/floors.txt
-    echo "floors before and after (notes/bench-baseline/floors.txt): a save is worth committing only if they agree with a calm spell's"
+    echo "floors before and after (notes/bench-baseline/floors.txt): a save is worth committing only if they agree with those of an idle machine"
     cat notes/bench-baseline/floors.txt
     ;;
   *) echo "usage: $0 compare|save [criterion args]" >&2; exit 2 ;;

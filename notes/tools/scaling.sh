@@ -2,7 +2,7 @@
 # Thread scaling of the default command: each phase's time at each thread
 # count, medians over REPS rounds, and the speedup against the 1-thread run.
 # Rounds go through the thread counts in turn (1, 2, 4, ..., then again) so
-# that a slow spell of a shared machine hits every count alike.
+# that a slow period of a shared machine hits every count alike.
 #
 #   notes/tools/scaling.sh [BIN] [REPS] [THREADS...]
 #   notes/tools/scaling.sh target/release/photonmap 3 1 2 4 8 12 16
