@@ -281,24 +281,40 @@ impl IrradianceCache {
         }
         // Almost always the nearest point is on the same surface; only near
         // edges and corners is a wider search needed.
-        match self.tree.nearest(x) {
+        let nearest_d2 = match self.tree.nearest(x) {
             None => return Color::ZERO,
             Some((d2, i)) if d2 <= self.points[i as usize].reach2 && self.points[i as usize].faces(n) => {
                 return Vec3::from(self.points[i as usize].irradiance);
             }
-            _ => {}
-        }
+            Some((d2, _)) => d2,
+        };
+        // The wider search grows its radius until a point answers: the first
+        // point found within r is the nearest of all that answer, since any
+        // other lies beyond r. One search at the largest reach read every
+        // point of a densely lit surface behind a thin wall (a wall's sunlit
+        // outer side, where most lookups on its inner side fell through):
+        // the sun-window scene's camera pass spent 75% of its time there.
+        let cell = 1.0 / self.cells.inv_cell;
+        let mut r2 = (4.0 * nearest_d2).max(cell * cell).min(self.max_reach2);
         let buf = &mut scratch.buf;
-        buf.clear();
-        self.tree.within(x, self.max_reach2, buf);
-        let mut best: Option<(f32, u32)> = None;
-        for (d2, i) in buf.iter().map(|&key| unpack(key)) {
-            let p = &self.points[i as usize];
-            if d2 <= p.reach2 && best.is_none_or(|b| d2 < b.0) && p.faces(n) {
-                best = Some((d2, i));
+        loop {
+            buf.clear();
+            self.tree.within(x, r2, buf);
+            let mut best: Option<(f32, u32)> = None;
+            for (d2, i) in buf.iter().map(|&key| unpack(key)) {
+                let p = &self.points[i as usize];
+                if d2 <= p.reach2 && best.is_none_or(|b| d2 < b.0 || (d2 == b.0 && i < b.1)) && p.faces(n) {
+                    best = Some((d2, i));
+                }
             }
+            if let Some((_, i)) = best {
+                return Vec3::from(self.points[i as usize].irradiance);
+            }
+            if r2 >= self.max_reach2 {
+                return Color::ZERO;
+            }
+            r2 = (4.0 * r2).min(self.max_reach2);
         }
-        best.map_or(Color::ZERO, |(_, i)| Vec3::from(self.points[i as usize].irradiance))
     }
 }
 

@@ -10,6 +10,7 @@
 use glam::{EulerRot, Mat3, Vec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
+use std::num::NonZeroUsize;
 
 fn rotation() -> Mat3 {
     Mat3::from_euler(EulerRot::XYZ, 0.61, 0.93, 0.37)
@@ -59,6 +60,24 @@ impl PointTree {
         if let Some(tree) = &self.tree {
             tree.query(&(self.rot * x).to_array()).within::<SquaredEuclidean<f32>>(r2).unsorted().visit(|n| f(n.item));
         }
+    }
+
+    /// Calls `f` with the index of each of the `n` points nearest to x
+    /// within sqrt(r2) (all of them, where fewer lie there), in no set
+    /// order; returns how many, and the squared distance of the farthest.
+    pub(crate) fn visit_nearest(&self, x: Vec3, r2: f32, n: usize, mut f: impl FnMut(u32)) -> (usize, f32) {
+        let (Some(tree), Some(n)) = (&self.tree, NonZeroUsize::new(n)) else {
+            return (0, 0.0);
+        };
+        let found = tree
+            .query(&(self.rot * x).to_array())
+            .nearest_n::<SquaredEuclidean<f32>>(n)
+            .within(r2)
+            .unsorted()
+            .execute();
+        let farthest = found.iter().map(|p| p.distance).fold(0.0, f32::max);
+        found.iter().for_each(|p| f(p.item));
+        (found.len(), farthest)
     }
 
     /// Pushes (squared distance, index) of every point within sqrt(r2) of x.

@@ -10,6 +10,7 @@
 //!   diffuse: the caustic map, read directly at visible surfaces.
 
 mod blocks;
+mod facing;
 mod grid;
 pub mod irradiance_cache;
 mod kdtree;
