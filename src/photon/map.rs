@@ -358,7 +358,7 @@ impl PhotonMap {
             // The tree's distances are the rotated positions': shrink the
             // radius known complete by the padding.
             let complete =
-                if complete >= wide * wide { r2 } else { (complete.sqrt() - 2.0 * self.tree_pad).max(0.0).powi(2) };
+                if complete >= wide * wide { r2 } else { (complete.sqrt() - self.tree_pad).max(0.0).powi(2) };
             (other, complete)
         } else {
             (tree.visit(x, wide * wide, n, keep), r2)
@@ -415,8 +415,11 @@ impl PhotonMap {
         let mut may_narrow = k > 0;
         // The tree is asked for a few more than the k nearest: the k nearest
         // facing like `n` are among them wherever at least k of them face
-        // so (away from edges, all do); else the search is repeated whole.
+        // so (away from edges, all do) and lie where the search was
+        // complete; else it is repeated for four times as many, and from
+        // 65,536 for all.
         let mut nearest = k + k / 2;
+        let more = |nearest: usize| if nearest == 0 || nearest >= 1 << 16 { 0 } else { 4 * nearest };
         let r2 = loop {
             let found = match self.within(x, r2, r_max, n, buf, (if may_narrow { k } else { 0 }, nearest)) {
                 Ok(found) => found,
@@ -449,7 +452,7 @@ impl PhotonMap {
                 let kth = *select.select_nth_unstable(k - 1).1;
                 if unpack(kth).0 > found.complete_r2 {
                     // A nearer photon may have been left out.
-                    nearest = 0;
+                    nearest = more(nearest);
                     continue;
                 }
                 let mut kept = 0;
@@ -462,7 +465,7 @@ impl PhotonMap {
                 break unpack(kth).0;
             }
             if found.complete_r2 < r2 {
-                nearest = 0;
+                nearest = more(nearest);
                 continue;
             }
             if r2 >= r_max2 || found.none_near {
