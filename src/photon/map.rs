@@ -283,7 +283,7 @@ impl PhotonMap {
     /// growing it if needed, and says what it found ([`Found`]).
     ///
     /// With `nearest > 0`, a search in the tree keeps only the `nearest`
-    /// photons nearest to `x` ([`Found::truncated`] where more may lie
+    /// photons nearest to `x` ([`Found::complete_r2`] says where more may lie
     /// within the radius): where a caustic's focus packs thousands of
     /// photons into the disk, reading them all for each estimate was 70%
     /// of a hall scene's camera pass (a glass ball's caustic on a table).
