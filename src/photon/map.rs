@@ -135,6 +135,9 @@ pub struct PhotonMap {
 pub struct IrradianceEstimate {
     pub irradiance: Color,
     pub r2: f32,
+    /// Photons in the disk (k where the k-th set its radius; fewer where
+    /// the radius cap did).
+    pub count: usize,
     pub other_surfaces: bool,
 }
 
@@ -505,7 +508,7 @@ impl PhotonMap {
     pub fn irradiance_estimate(&self, x: Vec3, n: Vec3, k: usize, r_max: f32, buf: &mut Scratch) -> IrradianceEstimate {
         let g = self.gather(x, n, k, r_max, buf);
         if g.count == 0 || !(g.r2 > 0.0) {
-            return IrradianceEstimate { irradiance: Color::ZERO, r2: g.r2, other_surfaces: false };
+            return IrradianceEstimate { irradiance: Color::ZERO, r2: g.r2, count: 0, other_surfaces: false };
         }
         let on_rim_excluded = g.r2 < r_max * r_max;
         let mut flux = Color::ZERO;
@@ -515,7 +518,7 @@ impl PhotonMap {
             }
         }
         let other_surfaces = if on_rim_excluded { g.other_r2 < g.r2 } else { g.other_r2 <= g.r2 };
-        IrradianceEstimate { irradiance: flux / (PI * g.r2), r2: g.r2, other_surfaces }
+        IrradianceEstimate { irradiance: flux / (PI * g.r2), r2: g.r2, count: g.count, other_surfaces }
     }
 
     /// Radiance reflected by a Lambertian surface of reflectance `rho`,
