@@ -10,7 +10,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 /// Grid cells of the irradiance cache's index, as a fraction of the lookup
-/// radius (twice the median estimate radius).
+/// radius (twice the median estimate radius over the surfaces' area).
 const CELL_FRACTION: f32 = 0.75;
 
 /// Irradiance precomputed at a subset of the global photons (Christensen
@@ -22,7 +22,8 @@ const CELL_FRACTION: f32 = 0.75;
 /// each (a quarter of the default camera pass, notes/performance.md). The
 /// points are therefore also bucketed by the cell of a uniform grid (cells
 /// hashed, each cell's points contiguous): a lookup reads its own cell's few
-/// points and takes the nearest one facing like the query; only where the
+/// points and takes the one facing like the query nearest relative to its
+/// reach ([`IrradianceCache::lookup`]); only where the
 /// cell holds none does it search the tree.
 pub struct IrradianceCache {
     points: Vec<CachePoint>,
