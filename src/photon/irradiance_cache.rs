@@ -191,7 +191,7 @@ impl IrradianceCache {
                         position: p.position().to_array(),
                         irradiance: e.to_array(),
                         normal: quantize_normal(n),
-                        inv_reach2: 1.0 / reach2(est.r2.min(r_max * r_max), est.count, k, r_max),
+                        inv_reach2: 1.0 / reach2(est.r2, est.count, k, r_max),
                     };
                     (point, r2)
                 },
@@ -338,8 +338,8 @@ impl IrradianceCache {
                     best = Some((q, i));
                 }
             }
-            // Every point that could beat the best lies within this.
-            let enough2 = best.map_or(self.max_reach2, |(q, _)| q * self.max_reach2).min(self.max_reach2);
+            // Every point that could beat the best lies within this (q <= 1).
+            let enough2 = best.map_or(self.max_reach2, |(q, _)| q * self.max_reach2);
             if r2 >= enough2 {
                 return best.map_or(Color::ZERO, |(_, i)| Vec3::from(self.points[i as usize].irradiance));
             }
