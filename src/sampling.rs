@@ -104,6 +104,19 @@ pub fn uniform_cone_pdf(cos_max: f32) -> f32 {
     1.0 / (2.0 * PI * (1.0 - cos_max))
 }
 
+/// Axis and cosine of the half-angle of the cone from `from` that just
+/// contains the sphere (`center`, `radius`); the whole sphere of
+/// directions (cosine -1) from inside it.
+pub fn cone_to_sphere(from: Vec3, center: Vec3, radius: f32) -> (Vec3, f32) {
+    let d = center - from;
+    let dist2 = d.length_squared();
+    if dist2 <= radius * radius || dist2 == 0.0 {
+        return (Vec3::Z, -1.0);
+    }
+    let sin2 = radius * radius / dist2;
+    (d / dist2.sqrt(), (1.0 - sin2).max(0.0).sqrt())
+}
+
 /// Uniform point on a triangle as barycentrics (b1, b2) of v1 and v2
 /// (pdf 1 / area); the square-root warp (Shirley & Chiu).
 pub fn uniform_triangle(u: Vec2) -> Vec2 {

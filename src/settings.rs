@@ -34,6 +34,10 @@ pub struct Settings {
     pub r_global: Option<f32>,
     pub r_caustic: Option<f32>,
     pub gather_rays: u32,
+    /// Of the gather rays at a diffuse camera hit, how many are aimed at the
+    /// mirror and glass objects and bright spots it sees (where it sees
+    /// any; one ray at least stays cosine-distributed).
+    pub aimed_gather_rays: u32,
     pub shadow_rays: u32,
     /// Irradiance is precomputed at every n-th global photon; `None`: at
     /// every (k_global / CACHE_POINTS_PER_DISK)-th ([`cache_stride`]).
@@ -66,6 +70,7 @@ pub const DEFAULT: Settings = Settings {
     r_global: None,
     r_caustic: None,
     gather_rays: 4,
+    aimed_gather_rays: 1,
     shadow_rays: 2,
     cache_stride: None,
     caustic_reuse: CAUSTIC_REUSE,

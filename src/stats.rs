@@ -66,6 +66,8 @@ pub struct Stats {
     /// caustic pass would get without aiming).
     pub global_specular_hits: u64,
     pub cache_points: usize,
+    /// Bright spots final gathering aims at.
+    pub spots: usize,
     pub map_bytes: usize,
     pub photon_rays: u64,
     /// The camera pass's counters.
@@ -119,6 +121,7 @@ impl Stats {
         self.global_stored = o.global_stored;
         self.caustic_stored = o.caustic_stored;
         self.cache_points = o.cache_points;
+        self.spots = o.spots;
         self.map_bytes = o.map_bytes;
         self.edge_pixels = o.edge_pixels;
         self.r_global = o.r_global;
@@ -190,6 +193,10 @@ impl Summary<'_> {
                 s.r_global,
                 s.r_caustic
             ));
+            if s.spots > 0 {
+                let plural = if s.spots == 1 { "" } else { "s" };
+                out.push(format!("               {} bright spot{plural} for final gathering to aim at", s.spots));
+            }
             out.push(format!(
                 "  photon pass  {:>8.3} s  {:>7.2} M photons/s  {:>7.2} M rays/s",
                 secs(s.photon_time),
@@ -203,7 +210,11 @@ impl Summary<'_> {
                 secs(s.cache_time)
             ));
         }
-        let gather = if st.method == Method::Photon { format!(", {} gather", st.gather_rays) } else { String::new() };
+        let gather = match (st.method, st.aimed_gather_rays.min(st.gather_rays.saturating_sub(1))) {
+            (Method::Photon, 0) => format!(", {} gather", st.gather_rays),
+            (Method::Photon, aimed) => format!(", {} gather ({aimed} aimed)", st.gather_rays),
+            _ => String::new(),
+        };
         out.push(format!(
             "  camera pass  {:>8.3} s  {:>7.2} M rays/s  ({} spp{gather}, {} shadow rays)",
             secs(s.camera_time),

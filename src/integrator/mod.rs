@@ -9,6 +9,7 @@
 //! at a time and keeps whatever state of its own it needs in the two
 //! associated types.
 
+mod aim;
 mod direct;
 pub mod path;
 pub mod photon;

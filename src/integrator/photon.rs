@@ -16,11 +16,13 @@
 //! Gather rays that reach a light (directly or through mirrors and glass)
 //! add nothing: those paths belong to the first two rows.
 
+use super::aim::AimCones;
 use super::{direct_light, Context, Integrator, Part};
 use crate::material::{Branch, Branches, Lobe, Material, Transport};
 use crate::math::{Color, Frame, Ray};
 use crate::photon::irradiance_cache::{CellRange, IrradianceCache};
 use crate::photon::map::{ConeEstimate, PhotonMap, Scratch};
+use crate::photon::spots::Spot;
 use crate::sampling::{cosine_hemisphere, next_2d, stratified_2d};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;
@@ -48,6 +50,10 @@ pub struct PhotonEstimator {
     pub r_caustic: f32,
     /// Final-gather rays per diffuse camera hit.
     pub gather_rays: u32,
+    /// Of the gather rays, how many are aimed at the mirror and glass
+    /// objects and bright spots a diffuse camera hit sees (none where it
+    /// sees none); fewer than `gather_rays`.
+    pub aimed_gather_rays: u32,
     /// Shadow rays per light per diffuse camera hit.
     pub shadow_rays: u32,
     /// Skip lights that face away from the shaded point.
@@ -81,6 +87,7 @@ pub struct PendingRead {
 pub struct PhotonThread {
     scratch: Scratch,
     pending: Vec<PendingRead>,
+    cones: AimCones,
 }
 
 /// What a pixel's samples share: its last caustic estimate, where it was
@@ -111,6 +118,8 @@ pub struct PhotonIntegrator<'a> {
     pub scene: &'a Scene,
     pub caustic: &'a PhotonMap,
     pub cache: &'a IrradianceCache,
+    /// Bright spots final gathering aims at.
+    pub spots: &'a [Spot],
     pub settings: PhotonEstimator,
 }
 
@@ -132,7 +141,7 @@ impl Integrator for PhotonIntegrator<'_> {
     /// Finds every read's cell first (each cell's slot was fetched when its
     /// gather ray hit, and this starts fetching the points), then reads.
     fn finish(&self, ctx: &mut Context, thread: &mut PhotonThread, _: &mut PhotonPixel) -> Color {
-        let PhotonThread { scratch, pending } = thread;
+        let PhotonThread { scratch, pending, .. } = thread;
         for p in pending.iter_mut() {
             p.cell = self.cache.locate(p.point);
         }
@@ -266,26 +275,61 @@ impl PhotonIntegrator<'_> {
     /// the scene): the reads are left for the end of the pixel's samples
     /// ([`PendingRead`]), all of their fetches under way at once. The
     /// random numbers are drawn in the same order either way.
+    ///
+    /// Where the point sees a mirror or glass object or a bright spot, some
+    /// of the rays are aimed at them ([`super::aim`]).
     fn indirect(&self, hit: &Hit, n: glam::Vec3, rho: Color, w: Color, sh: &mut Shade) -> Color {
         let count = self.settings.gather_rays;
         if count == 0 || self.cache.is_empty() {
             return Color::ZERO;
         }
+        let aims = self.settings.aimed_gather_rays.min(count - 1);
+        let aimed =
+            if aims > 0 && sh.thread.cones.prepare(self.aim_spheres(hit.point), hit.point, n) { aims } else { 0 };
+        let cosine = count - aimed;
         let frame = Frame::from_normal(n);
-        // Cosine-weighted directions: f cos / pdf = (rho / pi) cos / (cos / pi) = rho.
-        let w = w * rho / count as f32;
         let mut sum = Color::ZERO;
+        if aimed == 0 {
+            // Cosine-weighted directions: f cos / pdf = (rho / pi) cos / (cos / pi) = rho.
+            let w = w * rho / count as f32;
+            for g in 0..count {
+                let dir = frame.to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(sh.ctx.rng)))).normalize();
+                // About a shading normal a gather ray may point into the
+                // surface: it gathers nothing.
+                if hit.shading_normal != hit.normal && !hit.leaves_as(-n, dir, true) {
+                    continue;
+                }
+                let (ray, dep) = hit.spawn(dir);
+                sum += self.gather(ray, dep, Lobe::Diffuse, w, sh);
+            }
+            return rho * sum / count as f32;
+        }
+        // Each ray, cosine or aimed, weighed by the balance heuristic:
+        // f cos / (cosine p_cos + aimed p_aim), f = rho / pi, p_cos = cos / pi.
+        let (nc, na) = (cosine as f32, aimed as f32);
         for g in 0..count {
-            let dir = frame.to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(sh.ctx.rng)))).normalize();
-            // About a shading normal a gather ray may point into the
-            // surface: it gathers nothing.
-            if hit.shading_normal != hit.normal && !hit.leaves_as(-n, dir, true) {
+            let dir = if g < cosine {
+                frame.to_world(cosine_hemisphere(stratified_2d(g, cosine, next_2d(sh.ctx.rng)))).normalize()
+            } else {
+                let pick = ((g - cosine) as f32 + sh.ctx.rng.random::<f32>()) / na;
+                sh.thread.cones.sample(pick, next_2d(sh.ctx.rng))
+            };
+            let cos = dir.dot(n);
+            if !(cos > 0.0) || (hit.shading_normal != hit.normal && !hit.leaves_as(-n, dir, true)) {
                 continue;
             }
+            let c = cos / (nc * cos + na * PI * sh.thread.cones.pdf(dir));
             let (ray, dep) = hit.spawn(dir);
-            sum += self.gather(ray, dep, Lobe::Diffuse, w, sh);
+            sum += c * self.gather(ray, dep, Lobe::Diffuse, w * rho * c, sh);
         }
-        rho * sum / count as f32
+        rho * sum
+    }
+
+    /// What final gathering aims at: the mirror and glass objects' bounding
+    /// spheres and the bright spots' that face `x`.
+    fn aim_spheres(&self, x: glam::Vec3) -> impl Iterator<Item = (glam::Vec3, f32)> + '_ {
+        let targets = self.scene.specular_targets().iter().map(|t| (t.center, t.radius));
+        targets.chain(self.spots.iter().filter(move |s| s.faces(x)).map(|s| (s.center, s.radius)))
     }
 
     /// Radiance arriving along a gather ray that left a non-specular lobe

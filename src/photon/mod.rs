@@ -15,6 +15,7 @@ mod grid;
 pub mod irradiance_cache;
 mod kdtree;
 pub mod map;
+pub mod spots;
 pub mod trace;
 
 pub use blocks::PhotonBlocks;

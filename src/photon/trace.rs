@@ -166,7 +166,7 @@ fn aim(
         Light::Point { position, .. } => (*position, None),
         Light::Directional { .. } => unreachable!("handled above"),
     };
-    let (axis, cos_max) = cone_towards(origin, chosen.center, chosen.radius);
+    let (axis, cos_max) = chosen.cone_from(origin);
     // Unit to rounding without normalising (`Frame::to_world`).
     let dir = Frame::from_normal(axis).to_world(uniform_cone(next_2d(rng), cos_max));
     // The direction lies in the chosen cone by construction (a test
@@ -179,7 +179,7 @@ fn aim(
             if j == chosen_index {
                 return uniform_cone_pdf(cos_max);
             }
-            let (a, c) = cone_towards(origin, t.center, t.radius);
+            let (a, c) = t.cone_from(origin);
             if dir.dot(a) >= c {
                 uniform_cone_pdf(c)
             } else {
@@ -202,18 +202,6 @@ fn aim(
         Light::Directional { .. } => unreachable!("handled above"),
     };
     Some((Ray::new(origin, dir), departure, intensity * scale / pdf_dir))
-}
-
-/// Axis and cosine of the half-angle of the cone from `from` that just
-/// contains the sphere; the whole sphere of directions from inside it.
-fn cone_towards(from: Vec3, center: Vec3, radius: f32) -> (Vec3, f32) {
-    let d = center - from;
-    let dist2 = d.length_squared();
-    if dist2 <= radius * radius || dist2 == 0.0 {
-        return (Vec3::Z, -1.0);
-    }
-    let sin2 = radius * radius / dist2;
-    (d / dist2.sqrt(), (1.0 - sin2).max(0.0).sqrt())
 }
 
 /// One photon on its way: what the next segment needs.

@@ -5,6 +5,7 @@
 use crate::integrator::photon::{PhotonEstimator, PhotonIntegrator};
 use crate::photon::irradiance_cache::IrradianceCache;
 use crate::photon::map::PhotonMap;
+use crate::photon::spots::{bright_spots, Spot};
 use crate::photon::trace::{trace_pass, Pass};
 use crate::progress::{Mode, Phase};
 use crate::scene::Scene;
@@ -52,6 +53,7 @@ pub fn shrink(alpha: f32, pass: u32) -> f64 {
 pub struct Maps {
     pub caustic: PhotonMap,
     pub cache: IrradianceCache,
+    pub spots: Vec<Spot>,
 }
 
 /// Traces the photons of pass `pass` and builds its maps.
@@ -120,12 +122,15 @@ pub fn photon_pass(
     // their disk that lies on their surface.
     let coverage = |x, n, r| scene.disk_coverage(x, n, r, COVERAGE_SAMPLES);
     let cache = IrradianceCache::build_with(&global_map, stride, est.k_global, est.r_global, &coverage);
+    let aims = settings.aimed_gather_rays > 0 && settings.gather_rays > 1;
+    let spots = if aims { bright_spots(&cache.spot_points()) } else { Vec::new() };
     stats.cache_time += t.elapsed();
+    stats.spots = spots.len();
     stats.global_stored = global_map.len();
     stats.caustic_stored = caustic_map.len();
     stats.cache_points = cache.len();
     stats.map_bytes = global_map.memory_bytes() + caustic_map.memory_bytes();
-    Maps { caustic: caustic_map, cache }
+    Maps { caustic: caustic_map, cache, spots }
 }
 
 /// Rays measuring the part of an estimate's disk that lies on its surface
@@ -159,10 +164,12 @@ pub fn photon_integrator<'a>(
         scene,
         caustic: &maps.caustic,
         cache: &maps.cache,
+        spots: &maps.spots,
         settings: PhotonEstimator {
             k_caustic: est.k_caustic,
             r_caustic: est.r_caustic,
             gather_rays: settings.gather_rays,
+            aimed_gather_rays: settings.aimed_gather_rays.min(settings.gather_rays.saturating_sub(1)),
             shadow_rays: settings.shadow_rays,
             skip: settings.skip,
             caustic_reuse: settings.caustic_reuse,

@@ -137,6 +137,14 @@ pub struct Target {
     pub object: u32,
 }
 
+impl Target {
+    /// The cone from `from` that just contains the target's sphere
+    /// ([`crate::sampling::cone_to_sphere`]).
+    pub fn cone_from(&self, from: Vec3) -> (Vec3, f32) {
+        crate::sampling::cone_to_sphere(from, self.center, self.radius)
+    }
+}
+
 pub struct Scene {
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,

@@ -154,6 +154,12 @@ pub struct RenderArgs {
     /// Final-gather rays per diffuse camera hit (0: no indirect light).
     #[arg(long, default_value_t = DEFAULT.gather_rays, value_parser = clap::value_parser!(u32).range(0..=65_536))]
     gather_rays: u32,
+    /// Of the final-gather rays, how many are aimed at the mirror and glass
+    /// objects and the bright spots (a caustic's focus, a sunlit patch)
+    /// that a point sees, where it sees any; the rest are cosine-distributed,
+    /// one at least (0: all are).
+    #[arg(long, default_value_t = DEFAULT.aimed_gather_rays, value_parser = clap::value_parser!(u32).range(0..=65_536))]
+    aimed_gather_rays: u32,
     /// Shadow rays per light per diffuse camera hit.
     #[arg(long, default_value_t = DEFAULT.shadow_rays, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     shadow_rays: u32,
@@ -312,6 +318,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
         r_global: cli.max_radius,
         r_caustic: cli.caustic_radius,
         gather_rays: cli.gather_rays,
+        aimed_gather_rays: cli.aimed_gather_rays,
         shadow_rays: cli.shadow_rays,
         edge_spp: cli.edge_spp,
         cache_stride: cli.cache_stride.map(|n| n as usize),
