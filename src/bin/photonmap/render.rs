@@ -110,8 +110,7 @@ pub struct RenderArgs {
     /// all work) [default: 1e6; 2.5e5 for progressive renders].
     #[arg(long, value_parser = parse_count)]
     photons: Option<u64>,
-    /// Photons emitted towards mirrors and glass for the caustic map
-    /// [default: the same as --photons].
+    /// Photons emitted towards mirrors and glass [default: as --photons].
     #[arg(long, value_parser = parse_count)]
     caustic_photons: Option<u64>,
     /// Jittered camera samples per pixel (stratified when a square)
@@ -119,8 +118,7 @@ pub struct RenderArgs {
     /// progressive renders].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     spp: Option<u32>,
-    /// Seed of every random stream: the same seed gives the same image on any
-    /// number of threads.
+    /// Seed of every random stream: the same image on any number of threads.
     #[arg(long, default_value_t = DEFAULT.seed, value_parser = parse_seed)]
     seed: u64,
     /// Eye position: 1 = (-2,0,0), 53 degree view; 2 = (-1,0,0), 90 degrees.
@@ -154,10 +152,8 @@ pub struct RenderArgs {
     /// Final-gather rays per diffuse camera hit (0: no indirect light).
     #[arg(long, default_value_t = DEFAULT.gather_rays, value_parser = clap::value_parser!(u32).range(0..=65_536))]
     gather_rays: u32,
-    /// Of the final-gather rays, how many are aimed at the mirror and glass
-    /// objects and the bright spots (a caustic's focus, a sunlit patch)
-    /// that a point sees, where it sees any; the rest are cosine-distributed,
-    /// one at least (0: all are).
+    /// Of the gather rays, how many are aimed at the mirrors, glass and bright
+    /// spots a point sees, if any; one at least stays cosine (0: all do).
     #[arg(long, default_value_t = DEFAULT.aimed_gather_rays, value_parser = clap::value_parser!(u32).range(0..=65_536))]
     aimed_gather_rays: u32,
     /// Shadow rays per light per diffuse camera hit.
