@@ -42,6 +42,10 @@ const MAX_SPECULAR_DEPTH: u32 = 24;
 /// point.
 const REUSE_NORMAL_COSINE: f32 = 0.999;
 
+/// The fractional part of the golden ratio: a sequence stepping by it
+/// fills [0, 1) evenly at every length.
+const GOLDEN_RATIO_FRACTION: f32 = 0.618_034;
+
 /// Quality settings of the estimator.
 #[derive(Clone, Copy, Debug)]
 pub struct PhotonEstimator {
@@ -96,6 +100,11 @@ pub struct PhotonThread {
 #[derive(Default)]
 pub struct PhotonPixel {
     caustic: Option<CausticMemo>,
+    /// Where the pixel's aimed gather rays are in their choice of cone: a
+    /// golden-ratio sequence from a random start, so that a pixel's few
+    /// aimed rays spread over the cones its points see instead of
+    /// repeating one (each choice on its own is still uniform).
+    aim_pick: Option<f32>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -311,7 +320,11 @@ impl PhotonIntegrator<'_> {
             let dir = if g < cosine {
                 frame.to_world(cosine_hemisphere(stratified_2d(g, cosine, next_2d(sh.ctx.rng)))).normalize()
             } else {
-                let pick = ((g - cosine) as f32 + sh.ctx.rng.random::<f32>()) / na;
+                let pick = match sh.pixel.aim_pick {
+                    Some(p) => p,
+                    None => sh.ctx.rng.random::<f32>(),
+                };
+                sh.pixel.aim_pick = Some((pick + GOLDEN_RATIO_FRACTION).fract());
                 sh.thread.cones.sample(pick, next_2d(sh.ctx.rng))
             };
             let cos = dir.dot(n);
