@@ -256,20 +256,17 @@ impl IrradianceCache {
     }
 
     /// The points as [`crate::photon::spots`] reads them.
-    pub fn spot_points(&self) -> Vec<SpotPoint> {
-        self.points
-            .iter()
-            .map(|p| {
-                let (e, n) = (p.irradiance, p.normal);
-                SpotPoint {
-                    position: Vec3::from(p.position),
-                    normal: Vec3::new(n[0] as f32, n[1] as f32, n[2] as f32).normalize_or_zero(),
-                    irradiance: (e[0] + e[1] + e[2]) / 3.0,
-                    // The radius its estimate needed (a quarter of its reach).
-                    r2: 0.25 / p.inv_reach2,
-                }
-            })
-            .collect()
+    pub fn spot_points(&self) -> impl Iterator<Item = SpotPoint> + Clone + '_ {
+        self.points.iter().map(|p| {
+            let (e, n) = (p.irradiance, p.normal);
+            SpotPoint {
+                position: Vec3::from(p.position),
+                normal: Vec3::new(n[0] as f32, n[1] as f32, n[2] as f32).normalize_or_zero(),
+                irradiance: (e[0] + e[1] + e[2]) / 3.0,
+                // The radius its estimate needed (a quarter of its reach).
+                r2: 0.25 / p.inv_reach2,
+            }
+        })
     }
 
     pub fn len(&self) -> usize {

@@ -123,7 +123,7 @@ pub fn photon_pass(
     let coverage = |x, n, r| scene.disk_coverage(x, n, r, COVERAGE_SAMPLES);
     let cache = IrradianceCache::build_with(&global_map, stride, est.k_global, est.r_global, &coverage);
     let aims = settings.aimed_gather_rays > 0 && settings.gather_rays > 1;
-    let spots = if aims { bright_spots(&cache.spot_points()) } else { Vec::new() };
+    let spots = if aims { bright_spots(cache.spot_points()) } else { Vec::new() };
     stats.cache_time += t.elapsed();
     stats.spots = spots.len();
     stats.global_stored = global_map.len();
