@@ -79,6 +79,15 @@ pub const DEFAULT: Settings = Settings {
     alpha: 2.0 / 3.0,
 };
 
+impl Settings {
+    /// The gather rays aimed where a point sees anything to aim at: one at
+    /// least stays cosine-distributed (the aimed ones alone would miss
+    /// the rest of the hemisphere).
+    pub fn aimed_rays(&self) -> u32 {
+        self.aimed_gather_rays.min(self.gather_rays.saturating_sub(1))
+    }
+}
+
 impl Default for Settings {
     fn default() -> Self {
         DEFAULT

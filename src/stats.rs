@@ -210,7 +210,7 @@ impl Summary<'_> {
                 secs(s.cache_time)
             ));
         }
-        let gather = match (st.method, st.aimed_gather_rays.min(st.gather_rays.saturating_sub(1))) {
+        let gather = match (st.method, st.aimed_rays()) {
             (Method::Photon, 0) => format!(", {} gather", st.gather_rays),
             (Method::Photon, aimed) => format!(", {} gather ({aimed} aimed)", st.gather_rays),
             _ => String::new(),

@@ -6,21 +6,16 @@
 //! every time, weighed so that no light is counted twice: far fewer
 //! speckles, the same mean, a lower relative error.
 
+mod common;
+
 use photonmap::metrics::compare_images;
 use photonmap::progress::Mode;
 use photonmap::render::render;
-use photonmap::scene::Scene;
 use photonmap::settings::Settings;
-use std::path::Path;
 
 #[test]
 fn aimed_gather_rays_remove_the_small_lights_speckles_and_keep_its_light() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let suite = photonmap::suite::load(&root.join("scenes/suite")).expect("scenes/suite/suite.toml");
-    let s = suite.into_iter().find(|s| s.name == "04-small-light").expect("suite scene 4");
-    let reference = s.load_reference().expect("its reference");
-    let file = photonmap::scene::file::load(&s.scene).unwrap_or_else(|e| panic!("{e}"));
-    let scene = Scene::from_parts(file.parts);
+    let (s, scene, reference) = common::suite_scene("04-small-light");
     // Twice the reference's size: speckles are counted at full size.
     let base = Settings {
         photons: 200_000,

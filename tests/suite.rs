@@ -8,29 +8,19 @@
 //! notes/suite.md ("CI renders"). A failure leaves the render, the
 //! reference and their difference under target/test-artifacts/.
 
+mod common;
+
+use common::suite_scene;
 use photonmap::film::Film;
 use photonmap::metrics::compare_images;
 use photonmap::output::write;
 use photonmap::progress::Mode;
 use photonmap::render::render;
-use photonmap::scene::Scene;
 use photonmap::settings::Settings;
-use photonmap::suite::SuiteScene;
 use std::path::Path;
 
-fn suite_scene(name: &str) -> SuiteScene {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    photonmap::scene::procedural::write_suite_meshes(&root.join("scenes/suite/meshes"), name == "07-million")
-        .expect("the suite's meshes can be written");
-    let suite = photonmap::suite::load(&root.join("scenes/suite")).expect("scenes/suite/suite.toml");
-    suite.into_iter().find(|s| s.name == name).expect("a scene of the suite")
-}
-
 fn check(name: &str) {
-    let s = suite_scene(name);
-    let reference = s.load_reference().expect("the scene's reference");
-    let file = photonmap::scene::file::load(&s.scene).unwrap_or_else(|e| panic!("{e}"));
-    let scene = Scene::from_parts(file.parts);
+    let (s, scene, reference) = suite_scene(name);
     let settings = Settings {
         photons: 200_000,
         caustic_photons: 200_000,

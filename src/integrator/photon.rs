@@ -297,25 +297,11 @@ impl PhotonIntegrator<'_> {
             if aims > 0 && sh.thread.cones.prepare(self.aim_spheres(hit.point), hit.point, n) { aims } else { 0 };
         let cosine = count - aimed;
         let frame = Frame::from_normal(n);
-        let mut sum = Color::ZERO;
-        if aimed == 0 {
-            // Cosine-weighted directions: f cos / pdf = (rho / pi) cos / (cos / pi) = rho.
-            let w = w * rho / count as f32;
-            for g in 0..count {
-                let dir = frame.to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(sh.ctx.rng)))).normalize();
-                // About a shading normal a gather ray may point into the
-                // surface: it gathers nothing.
-                if hit.shading_normal != hit.normal && !hit.leaves_as(-n, dir, true) {
-                    continue;
-                }
-                let (ray, dep) = hit.spawn(dir);
-                sum += self.gather(ray, dep, Lobe::Diffuse, w, sh);
-            }
-            return rho * sum / count as f32;
-        }
         // Each ray, cosine or aimed, weighed by the balance heuristic:
-        // f cos / (cosine p_cos + aimed p_aim), f = rho / pi, p_cos = cos / pi.
+        // f cos / (cosine p_cos + aimed p_aim), f = rho / pi, p_cos = cos / pi;
+        // with cosine rays alone, 1 / count.
         let (nc, na) = (cosine as f32, aimed as f32);
+        let mut sum = Color::ZERO;
         for g in 0..count {
             let dir = if g < cosine {
                 frame.to_world(cosine_hemisphere(stratified_2d(g, cosine, next_2d(sh.ctx.rng)))).normalize()
@@ -328,10 +314,12 @@ impl PhotonIntegrator<'_> {
                 sh.thread.cones.sample(pick, next_2d(sh.ctx.rng))
             };
             let cos = dir.dot(n);
+            // About a shading normal a gather ray may point into the
+            // surface: it gathers nothing.
             if !(cos > 0.0) || (hit.shading_normal != hit.normal && !hit.leaves_as(-n, dir, true)) {
                 continue;
             }
-            let c = cos / (nc * cos + na * PI * sh.thread.cones.pdf(dir));
+            let c = if aimed == 0 { 1.0 / nc } else { cos / (nc * cos + na * PI * sh.thread.cones.pdf(dir)) };
             let (ray, dep) = hit.spawn(dir);
             sum += c * self.gather(ray, dep, Lobe::Diffuse, w * rho * c, sh);
         }

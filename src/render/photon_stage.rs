@@ -122,8 +122,7 @@ pub fn photon_pass(
     // their disk that lies on their surface.
     let coverage = |x, n, r| scene.disk_coverage(x, n, r, COVERAGE_SAMPLES);
     let cache = IrradianceCache::build_with(&global_map, stride, est.k_global, est.r_global, &coverage);
-    let aims = settings.aimed_gather_rays > 0 && settings.gather_rays > 1;
-    let spots = if aims { bright_spots(cache.spot_points()) } else { Vec::new() };
+    let spots = if settings.aimed_rays() > 0 { bright_spots(cache.spot_points()) } else { Vec::new() };
     stats.cache_time += t.elapsed();
     stats.spots = spots.len();
     stats.global_stored = global_map.len();
@@ -169,7 +168,7 @@ pub fn photon_integrator<'a>(
             k_caustic: est.k_caustic,
             r_caustic: est.r_caustic,
             gather_rays: settings.gather_rays,
-            aimed_gather_rays: settings.aimed_gather_rays.min(settings.gather_rays.saturating_sub(1)),
+            aimed_gather_rays: settings.aimed_rays(),
             shadow_rays: settings.shadow_rays,
             skip: settings.skip,
             caustic_reuse: settings.caustic_reuse,

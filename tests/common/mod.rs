@@ -31,6 +31,19 @@ pub fn ci_settings(size: u32) -> Settings {
     }
 }
 
+/// A scene of the suite (scenes/suite/), its meshes written first: its
+/// manifest entry, the scene built, and its reference.
+pub fn suite_scene(name: &str) -> (photonmap::suite::SuiteScene, Scene, Film) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    photonmap::scene::procedural::write_suite_meshes(&root.join("scenes/suite/meshes"), name == "07-million")
+        .expect("the suite's meshes can be written");
+    let suite = photonmap::suite::load(&root.join("scenes/suite")).expect("scenes/suite/suite.toml");
+    let s = suite.into_iter().find(|s| s.name == name).expect("a scene of the suite");
+    let reference = s.load_reference().expect("the scene's reference");
+    let file = photonmap::scene::file::load(&s.scene).unwrap_or_else(|e| panic!("{e}"));
+    (s, Scene::from_parts(file.parts), reference)
+}
+
 pub fn render_quiet(scene: &Scene, settings: &Settings) -> Film {
     let (film, stats) = render(scene, settings, Mode::Quiet);
     assert_eq!(stats.camera.nonfinite, 0, "non-finite samples: first at {:?}", stats.camera.first_nonfinite());
