@@ -113,8 +113,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let xml = work.join(format!("{}.xml", s.name));
             let file = photonmap::scene::file::load(&s.scene)?;
             let mesh_dir = format!("{}-meshes", s.name);
-            let exported = photonmap::export::mitsuba::to_mitsuba(&file.parts, Some(&file.origins), &mesh_dir)
-                .map_err(|r| r.describe(Some(&file.origins)))?;
+            // The reference's placement: Mitsuba's renders converge to it.
+            let placement = match s.mitsuba_placement {
+                Some((origin, scale)) => photonmap::export::mitsuba::Placement { origin, scale },
+                None => photonmap::export::mitsuba::Placement::at_eye(&file.parts.camera),
+            };
+            let exported =
+                photonmap::export::mitsuba::to_mitsuba(&file.parts, Some(&file.origins), &mesh_dir, placement)
+                    .map_err(|r| r.describe(Some(&file.origins)))?;
             std::fs::create_dir_all(work.join(&mesh_dir))?;
             for (name, bytes) in &exported.meshes {
                 std::fs::write(work.join(name), bytes)?;

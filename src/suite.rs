@@ -21,6 +21,15 @@ struct EntryDef {
     file: String,
     reference: String,
     caustic: WindowDef,
+    #[serde(default)]
+    mitsuba: Option<PlacementDef>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlacementDef {
+    origin: [f32; 3],
+    scale: f32,
 }
 
 #[derive(Deserialize)]
@@ -39,6 +48,10 @@ pub struct SuiteScene {
     pub reference: PathBuf,
     /// The caustic window, in the reference's pixels.
     pub caustic: Window,
+    /// Where the reference's Mitsuba scene puts its origin, and its scale
+    /// (`photonmap export --origin --scale`), where not at the eye: Mitsuba's
+    /// equal-time renders use the same.
+    pub mitsuba_placement: Option<(glam::Vec3, f32)>,
 }
 
 /// The reference's own noise and how it was made, from the JSON beside it
@@ -88,6 +101,7 @@ pub fn load(dir: &Path) -> Result<Vec<SuiteScene>, String> {
                 rows: (e.caustic.rows[0], e.caustic.rows[1]),
                 cols: (e.caustic.cols[0], e.caustic.cols[1]),
             },
+            mitsuba_placement: e.mitsuba.map(|p| (glam::Vec3::from(p.origin), p.scale)),
         })
         .collect())
 }

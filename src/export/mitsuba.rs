@@ -17,6 +17,17 @@
 //!
 //! The XML takes `spp`, `seed`, `width` and `height` as parameters
 //! (`mi.load_file(path, spp=...)`), defaulting to 64, 0 and the camera's size.
+//!
+//! Positions are written relative to the camera's eye, or to a chosen
+//! origin and scale ([`Placement`]). Mitsuba 3 starts a ray leaving a
+//! surface (1 + max |p|) x 8.9e-5 away from it along the normal, a length
+//! that grows with the distance from the origin: a glass ball of radius
+//! 0.15 twenty units from the origin refracts as if 1% of its radius
+//! thinner, which moves the window it shows by 0.14 pixel (the hall of the
+//! scene suite). Near the eye, where what the camera resolves lies, the
+//! offset is smaller; a reference that must resolve a small glass object
+//! puts the origin at it and scales the scene up, so that the offset is
+//! about 8.9e-5 of the distance to the origin.
 
 use super::ply::PlyMesh;
 use crate::camera::Camera;
@@ -56,12 +67,43 @@ impl Refusal {
     }
 }
 
+/// Where the exported scene lies: the point of the scene written as
+/// Mitsuba's origin, and how many of Mitsuba's units a scene unit is. The
+/// image is the same for every placement, up to Mitsuba's ray offsets.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    pub origin: Vec3,
+    pub scale: f32,
+}
+
+impl Placement {
+    /// The default: the camera's eye at the origin, lengths unchanged.
+    pub fn at_eye(camera: &Camera) -> Self {
+        Placement { origin: camera.eye, scale: 1.0 }
+    }
+
+    fn point(&self, p: Vec3) -> Vec3 {
+        (p - self.origin) * self.scale
+    }
+}
+
 /// Writes `parts` for Mitsuba 3, its meshes named `mesh_dir/NNN.ply`.
-pub fn to_mitsuba(parts: &SceneParts, origins: Option<&Origins>, mesh_dir: &str) -> Result<MitsubaScene, Refusal> {
+pub fn to_mitsuba(
+    parts: &SceneParts,
+    origins: Option<&Origins>,
+    mesh_dir: &str,
+    placement: Placement,
+) -> Result<MitsubaScene, Refusal> {
     let place = |f: &dyn Fn(&Origins) -> Option<&Place>| origins.and_then(f).cloned();
     let refuse = |place: Option<Place>, message: String| Refusal { place, message };
-    let mut out = Exporter { mesh_dir, xml: String::new(), meshes: Vec::new(), notes: Vec::new(), media: false };
-    let camera = sensor(&parts.camera).map_err(|m| refuse(place(&|o| Some(&o.camera)), m))?;
+    if !(placement.scale > 0.0 && placement.scale.is_finite() && placement.origin.is_finite()) {
+        return Err(refuse(None, format!("the placement {placement:?} needs a finite origin and a positive scale")));
+    }
+    let at = |p: Vec3| placement.point(p);
+    let s = placement.scale;
+    let mut out =
+        Exporter { mesh_dir, xml: String::new(), meshes: Vec::new(), notes: Vec::new(), media: false, placement };
+    let camera = sensor(&parts.camera, placement).map_err(|m| refuse(place(&|o| Some(&o.camera)), m))?;
 
     // Materials (those used), each defined once.
     let mut used = vec![false; parts.materials.len()];
@@ -83,7 +125,7 @@ pub fn to_mitsuba(parts: &SceneParts, origins: Option<&Origins>, mesh_dir: &str)
                 let _ = writeln!(
                     bsdfs,
                     "    <medium type=\"homogeneous\" id=\"medium{i}\">\n        <rgb name=\"sigma_t\" value=\"{}\"/>\n        <rgb name=\"albedo\" value=\"0, 0, 0\"/>\n    </medium>",
-                    rgb(*absorption)
+                    rgb(*absorption / s)
                 );
             }
         }
@@ -109,7 +151,7 @@ pub fn to_mitsuba(parts: &SceneParts, origins: Option<&Origins>, mesh_dir: &str)
             }
             let normals = if smooth { parts.shading_normals[t.shading as usize] } else { [t.normal; 3] };
             if let Some((_, _, mesh)) = run.as_mut() {
-                mesh.push([t.v0, t.v1, t.v2], normals);
+                mesh.push([t.v0, t.v1, t.v2].map(at), normals);
             }
             continue;
         }
@@ -117,15 +159,15 @@ pub fn to_mitsuba(parts: &SceneParts, origins: Option<&Origins>, mesh_dir: &str)
             shapes += &out.mesh(mesh, &refs(m), "");
         }
         shapes += &match p.shape {
-            Shape::Sphere(s) => format!(
+            Shape::Sphere(sphere) => format!(
                 "    <shape type=\"sphere\">\n        <point name=\"center\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{}\"/>\n{}    </shape>\n",
-                xyz(s.center),
-                s.radius,
+                xyz(at(sphere.center)),
+                sphere.radius * s,
                 refs(p.material)
             ),
             Shape::Disk(d) => format!(
                 "    <shape type=\"disk\">\n        {}\n{}    </shape>\n",
-                disk_transform(d.center, d.normal, d.radius),
+                disk_transform(at(d.center), d.normal, d.radius * s),
                 refs(p.material)
             ),
             Shape::Ellipsoid(e) => out.ellipsoid(&e, &refs(p.material)),
@@ -160,7 +202,7 @@ pub fn to_mitsuba(parts: &SceneParts, origins: Option<&Origins>, mesh_dir: &str)
                     tri_run = Some((key, radiance, material, PlyMesh::new(false)));
                 }
                 if let Some((_, _, _, mesh)) = tri_run.as_mut() {
-                    mesh.push([t.v0, t.v1, t.v2], [t.normal; 3]);
+                    mesh.push([t.v0, t.v1, t.v2].map(at), [t.normal; 3]);
                 }
             }
             LightSpec::Area { surface: Emitting::Disk(d), radiance, material } => {
@@ -168,7 +210,7 @@ pub fn to_mitsuba(parts: &SceneParts, origins: Option<&Origins>, mesh_dir: &str)
                 let _ = write!(
                     emitters,
                     "    <shape type=\"disk\">\n        {}\n{}        <emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>\n    </shape>\n",
-                    disk_transform(d.center, d.normal, d.radius),
+                    disk_transform(at(d.center), d.normal, d.radius * s),
                     bsdf_ref(material),
                     rgb(radiance)
                 );
@@ -187,8 +229,9 @@ pub fn to_mitsuba(parts: &SceneParts, origins: Option<&Origins>, mesh_dir: &str)
                 let _ = write!(
                     emitters,
                     "    <emitter type=\"point\">\n        <point name=\"position\" value=\"{}\"/>\n        <rgb name=\"intensity\" value=\"{}\"/>\n    </emitter>\n",
-                    xyz(position),
-                    rgb(intensity)
+                    xyz(at(position)),
+                    // 1/d^2 with every d scaled.
+                    rgb(intensity * (s * s))
                 );
             }
             LightSpec::Directional { direction, irradiance } => {
@@ -209,11 +252,14 @@ pub fn to_mitsuba(parts: &SceneParts, origins: Option<&Origins>, mesh_dir: &str)
     let mut xml = String::new();
     let _ = write!(
         xml,
-        "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!-- Written by photonmap export. Parameters: spp, seed, width, height. -->\n\
+        "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!-- Written by photonmap export. Parameters: spp, seed, width, height. \
+         A point p of the scene is here (p - ({})) x {}. -->\n\
          <scene version=\"3.0.0\">\n    <default name=\"spp\" value=\"64\"/>\n    <default name=\"seed\" value=\"0\"/>\n\
          \x20   <default name=\"width\" value=\"{w}\"/>\n    <default name=\"height\" value=\"{h}\"/>\n\
          \x20   <integrator type=\"{integrator}\">\n        <integer name=\"max_depth\" value=\"-1\"/>\n    </integrator>\n\
-         {camera}{bsdfs}{shapes}{emitters}</scene>\n"
+         {camera}{bsdfs}{shapes}{emitters}</scene>\n",
+        xyz(placement.origin),
+        s
     );
     out.xml = xml;
     Ok(MitsubaScene { xml: out.xml, meshes: out.meshes, notes: out.notes })
@@ -225,6 +271,7 @@ struct Exporter<'a> {
     meshes: Vec<(String, Vec<u8>)>,
     notes: Vec<String>,
     media: bool,
+    placement: Placement,
 }
 
 impl Exporter<'_> {
@@ -243,7 +290,8 @@ impl Exporter<'_> {
     /// An ellipsoid: a `sphere` when its transform scales evenly, else a
     /// tessellation with the ellipsoid's own normals at its vertices.
     fn ellipsoid(&mut self, e: &Ellipsoid, refs: &str) -> String {
-        let m = e.to_world();
+        let p = self.placement;
+        let m = Affine3A::from_scale(Vec3::splat(p.scale)) * Affine3A::from_translation(-p.origin) * e.to_world();
         let cols = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis];
         let s = cols[0].length();
         let even = cols.iter().all(|c| (c.length() - s).abs() <= 1e-5 * s)
@@ -310,8 +358,9 @@ fn bsdf(m: &Material, id: &str) -> Result<String, String> {
     })
 }
 
-/// The camera as a Mitsuba `perspective` sensor, or why it cannot be one.
-fn sensor(camera: &Camera) -> Result<String, String> {
+/// The camera as a Mitsuba `perspective` sensor, or why it cannot be one;
+/// placed by `placement`.
+fn sensor(camera: &Camera, placement: Placement) -> Result<String, String> {
     let (upper_left, across, down) = camera.plane();
     let (w, h) = (camera.width as f32, camera.height as f32);
     let (la, ld) = (across.length(), down.length());
@@ -361,10 +410,10 @@ fn sensor(camera: &Camera) -> Result<String, String> {
          \x20       <sampler type=\"independent\"><integer name=\"sample_count\" value=\"$spp\"/><integer name=\"seed\" value=\"$seed\"/></sampler>\n\
          \x20       <film type=\"hdrfilm\"><integer name=\"width\" value=\"$width\"/><integer name=\"height\" value=\"$height\"/>\
          <string name=\"pixel_format\" value=\"rgb\"/><string name=\"component_format\" value=\"float32\"/><rfilter type=\"box\"/></film>\n    </sensor>\n",
-        1e-4 * distance,
-        1e7 * distance,
-        xyz(camera.eye),
-        xyz(camera.eye + forward),
+        1e-4 * distance * placement.scale,
+        1e7 * distance * placement.scale,
+        xyz(placement.point(camera.eye)),
+        xyz(placement.point(camera.eye) + forward),
         xyz(up)
     ))
 }
@@ -402,7 +451,8 @@ mod tests {
     }
 
     fn export(parts: &SceneParts) -> MitsubaScene {
-        to_mitsuba(parts, None, "m").unwrap_or_else(|r| panic!("{}", r.describe(None)))
+        to_mitsuba(parts, None, "m", Placement::at_eye(&parts.camera))
+            .unwrap_or_else(|r| panic!("{}", r.describe(None)))
     }
 
     /// The default room: every feature of it has its element.
@@ -414,7 +464,10 @@ mod tests {
         for want in [
             "type=\"perspective\"",
             "name=\"fov\" value=\"53.13",
-            "<lookat origin=\"-2, 0, 0\"",
+            // Positions relative to the eye at (-2, 0, 0): the glass
+            // sphere's centre (9.5, -2, -3) is written 2 further along x.
+            "<lookat origin=\"0, 0, 0\"",
+            "name=\"center\" value=\"11.5, -2, -3\"",
             "type=\"twosided\"",
             "type=\"dielectric\"",
             "name=\"int_ior\" value=\"1.5\"",
@@ -521,15 +574,55 @@ mod tests {
             mirror: 0.0,
         });
         let parts = parts_with(vec![Prim { shape: Shape::Triangle(t), material: 0, object: 0 }], vec![phong], vec![]);
-        let r = to_mitsuba(&parts, None, "m").err().expect("refused");
+        let r = to_mitsuba(&parts, None, "m", Placement::at_eye(&parts.camera)).err().expect("refused");
         assert!(r.message.contains("Phong"));
         let falloff = LightSpec::Point { position: Vec3::ONE, intensity: Color::ONE, falloff: 1.0, dead_distance: 0.0 };
         let parts = parts_with(vec![], vec![], vec![falloff]);
-        assert!(to_mitsuba(&parts, None, "m").err().expect("refused").message.contains("1/d^2"));
+        assert!(to_mitsuba(&parts, None, "m", Placement::at_eye(&parts.camera))
+            .err()
+            .expect("refused")
+            .message
+            .contains("1/d^2"));
         // Non-square pixels.
         let mut parts = parts_with(vec![], vec![], vec![]);
         parts.camera = parts.camera.with_resolution(400, 200);
-        assert!(to_mitsuba(&parts, None, "m").err().expect("refused").message.contains("square"));
+        assert!(to_mitsuba(&parts, None, "m", Placement::at_eye(&parts.camera))
+            .err()
+            .expect("refused")
+            .message
+            .contains("square"));
+    }
+
+    /// A placement moves and scales every length, and what depends on
+    /// lengths with them: the image stays the same.
+    #[test]
+    fn a_placement_moves_and_scales_every_length() {
+        let ball = crate::shape::Sphere { center: Vec3::new(3.0, 1.0, 1.0), radius: 0.5 };
+        let parts = parts_with(
+            vec![Prim { shape: Shape::Sphere(ball), material: 0, object: 0 }],
+            vec![Material::Glass { ior: 1.5, absorption: Color::splat(0.4) }],
+            vec![LightSpec::Point {
+                position: Vec3::new(1.0, 1.0, 3.0),
+                intensity: Color::splat(5.0),
+                falloff: 2.0,
+                dead_distance: 0.0,
+            }],
+        );
+        let placement = Placement { origin: Vec3::new(3.0, 1.0, 1.0), scale: 100.0 };
+        let x = to_mitsuba(&parts, None, "m", placement).unwrap_or_else(|r| panic!("{}", r.describe(None))).xml;
+        for want in [
+            "name=\"center\" value=\"0, 0, 0\"",
+            "name=\"radius\" value=\"50\"",
+            "name=\"position\" value=\"-200, 0, 200\"",
+            "name=\"intensity\" value=\"50000, 50000, 50000\"",
+            "name=\"sigma_t\" value=\"0.004, 0.004, 0.004\"",
+            // The room's eye, (-2, 0, 0).
+            "<lookat origin=\"-500, -100, -100\"",
+        ] {
+            assert!(x.contains(want), "missing {want}:\n{x}");
+        }
+        let bad = Placement { origin: Vec3::ZERO, scale: 0.0 };
+        assert!(to_mitsuba(&parts, None, "m", bad).is_err());
     }
 
     /// An eye off the plane's centre is kept by the principal point's offset.

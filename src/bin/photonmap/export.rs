@@ -2,7 +2,7 @@
 //! Mitsuba 3 (photonmap::export::mitsuba), its meshes beside it.
 
 use photonmap::error::Error;
-use photonmap::export::mitsuba::to_mitsuba;
+use photonmap::export::mitsuba::{to_mitsuba, Placement};
 use photonmap::output::same_file;
 use photonmap::output::write_bytes;
 use photonmap::scene::{Eye, Scene};
@@ -25,6 +25,28 @@ pub struct Args {
     /// Built-in room: eye 1 = (-2,0,0), 2 = (-1,0,0).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2))]
     eye: Option<u8>,
+    /// The point of the scene written as Mitsuba's origin [default: the
+    /// camera's eye]. Mitsuba offsets a ray leaving a surface by a length
+    /// that grows with the distance from its origin: for a reference that
+    /// resolves a small glass object, give its centre here.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_point)]
+    origin: Option<glam::Vec3>,
+    /// Mitsuba's units per scene unit (the image is the same); with
+    /// --origin, a large scale makes the ray offsets a fixed fraction of
+    /// the distance from the origin.
+    #[arg(long, default_value_t = 1.0)]
+    scale: f32,
+}
+
+fn parse_point(text: &str) -> Result<glam::Vec3, String> {
+    let v: Vec<f32> = text
+        .split(',')
+        .map(|c| c.trim().parse::<f32>().map_err(|e| format!("{c:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(glam::Vec3::new(*x, *y, *z)),
+        _ => Err("give three finite numbers, X,Y,Z".into()),
+    }
 }
 
 pub fn run(args: Args) -> Result<(), Error> {
@@ -54,8 +76,12 @@ pub fn run(args: Args) -> Result<(), Error> {
     };
     let stem = out.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let mesh_dir = format!("{stem}-meshes");
-    let exported =
-        to_mitsuba(&parts, origins.as_ref(), &mesh_dir).map_err(|r| Error::Invalid(r.describe(origins.as_ref())))?;
+    if !(args.scale > 0.0 && args.scale.is_finite()) {
+        return Err(Error::Invalid(format!("--scale {}: give a positive number", args.scale)));
+    }
+    let placement = Placement { origin: args.origin.unwrap_or(parts.camera.eye), scale: args.scale };
+    let exported = to_mitsuba(&parts, origins.as_ref(), &mesh_dir, placement)
+        .map_err(|r| Error::Invalid(r.describe(origins.as_ref())))?;
     let dir = out.parent().filter(|p| !p.as_os_str().is_empty()).map(PathBuf::from).unwrap_or_else(|| ".".into());
     if !exported.meshes.is_empty() {
         let meshes = dir.join(&mesh_dir);
