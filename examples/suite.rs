@@ -115,7 +115,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mesh_dir = format!("{}-meshes", s.name);
             // The reference's placement: Mitsuba's renders converge to it.
             let placement = match s.mitsuba_placement {
-                Some((origin, scale)) => photonmap::export::mitsuba::Placement { origin, scale },
+                Some((origin, scale)) => photonmap::export::mitsuba::Placement::new(origin, scale)?,
                 None => photonmap::export::mitsuba::Placement::at_eye(&file.parts.camera),
             };
             let exported =

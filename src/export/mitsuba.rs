@@ -72,11 +72,22 @@ impl Refusal {
 /// image is the same for every placement, up to Mitsuba's ray offsets.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Placement {
-    pub origin: Vec3,
-    pub scale: f32,
+    origin: Vec3,
+    scale: f32,
 }
 
 impl Placement {
+    /// `origin` written as (0, 0, 0), lengths times `scale`; or why not.
+    pub fn new(origin: Vec3, scale: f32) -> Result<Self, String> {
+        if !origin.is_finite() {
+            return Err(format!("origin {origin}: give three finite numbers"));
+        }
+        if !(scale > 0.0 && scale.is_finite()) {
+            return Err(format!("scale {scale}: give a positive number"));
+        }
+        Ok(Placement { origin, scale })
+    }
+
     /// The default: the camera's eye at the origin, lengths unchanged.
     pub fn at_eye(camera: &Camera) -> Self {
         Placement { origin: camera.eye, scale: 1.0 }
@@ -96,9 +107,6 @@ pub fn to_mitsuba(
 ) -> Result<MitsubaScene, Refusal> {
     let place = |f: &dyn Fn(&Origins) -> Option<&Place>| origins.and_then(f).cloned();
     let refuse = |place: Option<Place>, message: String| Refusal { place, message };
-    if !(placement.scale > 0.0 && placement.scale.is_finite() && placement.origin.is_finite()) {
-        return Err(refuse(None, format!("the placement {placement:?} needs a finite origin and a positive scale")));
-    }
     let at = |p: Vec3| placement.point(p);
     let s = placement.scale;
     let mut out =
@@ -608,7 +616,7 @@ mod tests {
                 dead_distance: 0.0,
             }],
         );
-        let placement = Placement { origin: Vec3::new(3.0, 1.0, 1.0), scale: 100.0 };
+        let placement = Placement::new(Vec3::new(3.0, 1.0, 1.0), 100.0).unwrap();
         let x = to_mitsuba(&parts, None, "m", placement).unwrap_or_else(|r| panic!("{}", r.describe(None))).xml;
         for want in [
             "name=\"center\" value=\"0, 0, 0\"",
@@ -621,8 +629,8 @@ mod tests {
         ] {
             assert!(x.contains(want), "missing {want}:\n{x}");
         }
-        let bad = Placement { origin: Vec3::ZERO, scale: 0.0 };
-        assert!(to_mitsuba(&parts, None, "m", bad).is_err());
+        assert!(Placement::new(Vec3::ZERO, 0.0).is_err());
+        assert!(Placement::new(Vec3::new(f32::NAN, 0.0, 0.0), 1.0).is_err());
     }
 
     /// An eye off the plane's centre is kept by the principal point's offset.

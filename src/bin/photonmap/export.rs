@@ -76,10 +76,8 @@ pub fn run(args: Args) -> Result<(), Error> {
     };
     let stem = out.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let mesh_dir = format!("{stem}-meshes");
-    if !(args.scale > 0.0 && args.scale.is_finite()) {
-        return Err(Error::Invalid(format!("--scale {}: give a positive number", args.scale)));
-    }
-    let placement = Placement { origin: args.origin.unwrap_or(parts.camera.eye), scale: args.scale };
+    let placement = Placement::new(args.origin.unwrap_or(parts.camera.eye), args.scale)
+        .map_err(|m| Error::Invalid(format!("export: {m}")))?;
     let exported = to_mitsuba(&parts, origins.as_ref(), &mesh_dir, placement)
         .map_err(|r| Error::Invalid(r.describe(origins.as_ref())))?;
     let dir = out.parent().filter(|p| !p.as_os_str().is_empty()).map(PathBuf::from).unwrap_or_else(|| ".".into());
