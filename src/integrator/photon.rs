@@ -150,13 +150,13 @@ impl Integrator for PhotonIntegrator<'_> {
     /// Finds every read's cell first (each cell's slot was fetched when its
     /// gather ray hit, and this starts fetching the points), then reads.
     fn finish(&self, ctx: &mut Context, thread: &mut PhotonThread, _: &mut PhotonPixel) -> Color {
-        let PhotonThread { scratch, pending, .. } = thread;
+        let pending = &mut thread.pending;
         for p in pending.iter_mut() {
             p.cell = self.cache.locate(p.point);
         }
         let mut sum = Color::ZERO;
         for p in pending.iter() {
-            sum += p.weight * self.cache.lookup_in(p.point, p.normal, p.cell, scratch);
+            sum += p.weight * self.cache.lookup_in(p.point, p.normal, p.cell);
         }
         pending.clear();
         ctx.checked(sum, "indirect")
@@ -415,7 +415,7 @@ impl PhotonIntegrator<'_> {
             sh.thread.pending.push(PendingRead { point, normal, weight: w * weight, ..Default::default() });
             Color::ZERO
         } else {
-            weight * self.cache.lookup(point, normal, &mut sh.thread.scratch)
+            weight * self.cache.lookup(point, normal)
         }
     }
 

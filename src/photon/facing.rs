@@ -1,6 +1,7 @@
-//! A photon map's kd-trees, one per facing class: photons are split by
-//! the dominant axis and sign of their surface normal, and a search for
-//! photons facing like a normal reads only the classes that can hold one.
+//! A photon map's (and the irradiance cache's) kd-trees, one per facing
+//! class: photons are split by the dominant axis and sign of their surface
+//! normal, and a search for photons facing like a normal reads only the
+//! classes that can hold one.
 //!
 //! An estimate counts only photons on a surface facing like its own
 //! ([`super::map::PhotonMap`]). Where another surface's photons crowd the
@@ -79,20 +80,43 @@ impl Class {
 impl FacingTrees {
     /// Trees over `photons`, in the order given (items are places in it).
     pub(crate) fn build(photons: &[Photon]) -> Self {
+        Self::build_from(photons.len(), |i| (photons[i].position(), photons[i].surface_normal()))
+    }
+
+    /// Trees over `count` points, point i at `point(i)` = (position,
+    /// surface normal); items are the indices i.
+    pub(crate) fn build_from(count: usize, point: impl Fn(usize) -> (Vec3, Vec3) + Sync) -> Self {
         let mut members: Vec<Vec<u32>> = vec![Vec::new(); 6];
-        for (i, p) in photons.iter().enumerate() {
-            members[class_of(p.surface_normal())].push(i as u32);
+        for i in 0..count {
+            members[class_of(point(i).1)].push(i as u32);
         }
         let classes = members
             .into_par_iter()
             .enumerate()
             .filter(|(_, items)| !items.is_empty())
             .map(|(c, items)| {
-                let tree = PointTree::build(items.par_iter().map(|&i| photons[i as usize].position()));
+                let tree = PointTree::build(items.par_iter().map(|&i| point(i as usize).0));
                 Class::new(c, items, tree)
             })
             .collect();
         FacingTrees { classes }
+    }
+
+    /// The classes, each as its list of items (the order of the indices
+    /// the other methods take).
+    pub(crate) fn class_items(&self) -> impl Iterator<Item = &[u32]> {
+        self.classes.iter().map(|c| c.items.as_slice())
+    }
+
+    /// The indices of the classes that may hold a point facing like `n`.
+    pub(crate) fn facing(&self, n: Vec3) -> impl Iterator<Item = usize> + '_ {
+        self.classes.iter().enumerate().filter(move |(_, c)| c.may_face(n)).map(|(i, _)| i)
+    }
+
+    /// Calls `f` with every point of class `c` within sqrt(r2) of x.
+    pub(crate) fn visit_in(&self, c: usize, x: Vec3, r2: f32, mut f: impl FnMut(u32)) {
+        let class = &self.classes[c];
+        class.tree.visit(x, r2, |item| f(class.items[item as usize]));
     }
 
     /// Calls `f` with every photon within sqrt(r2) of x in a class that may

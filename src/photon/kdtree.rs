@@ -47,14 +47,6 @@ impl PointTree {
         PointTree { tree, rot }
     }
 
-    /// (squared distance, index) of the nearest point, if any.
-    pub(crate) fn nearest(&self, x: Vec3) -> Option<(f32, u32)> {
-        self.tree.as_ref().map(|tree| {
-            let n = tree.query(&(self.rot * x).to_array()).nearest_one::<SquaredEuclidean<f32>>().execute();
-            (n.distance, n.item)
-        })
-    }
-
     /// Calls `f` with the index of every point within sqrt(r2) of x.
     pub(crate) fn visit(&self, x: Vec3, r2: f32, mut f: impl FnMut(u32)) {
         if let Some(tree) = &self.tree {
@@ -78,15 +70,5 @@ impl PointTree {
         let farthest = found.iter().map(|p| p.distance).fold(0.0, f32::max);
         found.iter().for_each(|p| f(p.item));
         (found.len(), farthest)
-    }
-
-    /// Pushes (squared distance, index) of every point within sqrt(r2) of x.
-    pub(crate) fn within(&self, x: Vec3, r2: f32, buf: &mut Vec<u64>) {
-        if let Some(tree) = &self.tree {
-            tree.query(&(self.rot * x).to_array())
-                .within::<SquaredEuclidean<f32>>(r2)
-                .unsorted()
-                .visit(|n| buf.push(found(n.distance, n.item)));
-        }
     }
 }
