@@ -5,40 +5,56 @@
 //! object's small solid angle, often focused into a smaller one still: a
 //! cosine-distributed gather ray finds it rarely and then carries a large
 //! value, a bright speckle in an otherwise smooth image. A few gather rays
-//! are therefore aimed, uniformly in the cone of each mirror or glass
-//! object's bounding sphere (the caustic photons' targets), and every gather
-//! ray, cosine or aimed, is weighed by the balance heuristic (Veach 1997,
-//! multi-sample model): f cos / (n_cos p_cos + n_aim p_aim). No light is
-//! lost or counted twice, whatever the cones hold.
+//! are therefore aimed: uniformly in the cone of each mirror or glass
+//! object's bounding sphere (the caustic photons' targets), and uniformly
+//! over the disk that bounds each flat bright spot in its plane. Every
+//! gather ray, cosine or aimed, is weighed by the balance heuristic (Veach
+//! 1997, multi-sample model): f cos / (n_cos p_cos + n_aim p_aim). No light
+//! is lost or counted twice, whatever the targets hold.
 
 use crate::math::Frame;
-use crate::sampling::{cone_to_sphere, uniform_cone, uniform_cone_pdf};
+use crate::sampling::{concentric_disk, cone_to_sphere, uniform_cone, uniform_cone_pdf};
 use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
 
-/// One target's cone as seen from the gathering point.
+/// What final gathering aims at.
 #[derive(Clone, Copy, Debug)]
-struct Cone {
-    axis: Vec3,
-    cos_max: f32,
-    pdf: f32,
+pub enum Aim {
+    /// A sphere (centre, radius): directions uniform in its cone.
+    Sphere(Vec3, f32),
+    /// A flat disk (centre, unit normal, radius): points uniform on it. A
+    /// flat bright spot (a sunlit patch on a floor) seen from a wall at a
+    /// grazing angle fills a few times less of its bounding sphere's cone
+    /// than of the cone's directions aimed at its disk.
+    Disk(Vec3, Vec3, f32),
 }
 
-/// The cones of the targets a gathering point can see above its horizon,
-/// kept by a thread between points (no allocation per point).
+/// One target as seen from the gathering point.
+#[derive(Clone, Copy, Debug)]
+enum Target {
+    Cone { axis: Vec3, cos_max: f32, pdf: f32 },
+    Disk { center: Vec3, frame: Frame, radius: f32 },
+}
+
+/// The targets a gathering point can see above its horizon, kept by a
+/// thread between points (no allocation per point).
 #[derive(Default)]
 pub struct AimCones {
-    cones: Vec<Cone>,
+    x: Vec3,
+    targets: Vec<Target>,
 }
 
 impl AimCones {
-    /// The cones, from `x` on a surface facing `n`, of the spheres (centre,
-    /// radius) that reach above its horizon; false where there are none. A
-    /// sphere that
-    /// holds `x` (a cone wider than the hemisphere) is left to the cosine
-    /// rays: aiming at it would only repeat them.
-    pub fn prepare(&mut self, spheres: impl Iterator<Item = (Vec3, f32)>, x: Vec3, n: Vec3) -> bool {
-        self.cones.clear();
-        for (center, radius) in spheres {
+    /// The targets, from `x` on a surface facing `n`, that reach above its
+    /// horizon (judged by their bounding spheres); false where there are
+    /// none. A target whose bounding sphere holds `x` (a cone wider than
+    /// the hemisphere) is left to the cosine rays: aiming at it would only
+    /// repeat them.
+    pub fn prepare(&mut self, aims: impl Iterator<Item = Aim>, x: Vec3, n: Vec3) -> bool {
+        self.targets.clear();
+        self.x = x;
+        for aim in aims {
+            let (Aim::Sphere(center, radius) | Aim::Disk(center, _, radius)) = aim;
             let (axis, cos_max) = cone_to_sphere(x, center, radius);
             if !(cos_max > 0.0) {
                 continue;
@@ -47,23 +63,63 @@ impl AimCones {
             if axis.dot(n) <= -sin_max {
                 continue;
             }
-            self.cones.push(Cone { axis, cos_max, pdf: uniform_cone_pdf(cos_max) });
+            self.targets.push(match aim {
+                Aim::Sphere(..) => Target::Cone { axis, cos_max, pdf: uniform_cone_pdf(cos_max) },
+                Aim::Disk(center, normal, radius) => Target::Disk { center, frame: Frame::from_normal(normal), radius },
+            });
         }
-        !self.cones.is_empty()
+        !self.targets.is_empty()
     }
 
-    /// A direction uniform in one cone, chosen by `pick` in [0, 1).
+    /// A direction towards one target, chosen by `pick` in [0, 1).
     pub fn sample(&self, pick: f32, u: Vec2) -> Vec3 {
-        let i = ((pick * self.cones.len() as f32) as usize).min(self.cones.len() - 1);
-        let c = &self.cones[i];
-        Frame::from_normal(c.axis).to_world(uniform_cone(u, c.cos_max)).normalize()
+        let i = ((pick * self.targets.len() as f32) as usize).min(self.targets.len() - 1);
+        match self.targets[i] {
+            Target::Cone { axis, cos_max, .. } => {
+                Frame::from_normal(axis).to_world(uniform_cone(u, cos_max)).normalize()
+            }
+            Target::Disk { center, frame, radius } => {
+                let d = concentric_disk(u) * radius;
+                (center + frame.to_world(Vec3::new(d.x, d.y, 0.0)) - self.x).normalize_or(frame.n)
+            }
+        }
     }
 
     /// The pdf of [`Self::sample`] per unit solid angle towards `dir`:
-    /// the mixture over the cones that hold it.
+    /// the mixture over the targets that hold it.
     pub fn pdf(&self, dir: Vec3) -> f32 {
-        let sum: f32 = self.cones.iter().filter(|c| dir.dot(c.axis) >= c.cos_max).map(|c| c.pdf).sum();
-        sum / self.cones.len() as f32
+        let sum: f32 = self.targets.iter().map(|t| t.pdf(self.x, dir)).sum();
+        sum / self.targets.len() as f32
+    }
+}
+
+impl Target {
+    /// The pdf per unit solid angle of a direction uniform in the cone, or
+    /// towards a point uniform on the disk (area pdf 1 / (pi r^2), times
+    /// distance^2 / cos at the disk).
+    fn pdf(&self, x: Vec3, dir: Vec3) -> f32 {
+        match *self {
+            Target::Cone { axis, cos_max, pdf } => {
+                if dir.dot(axis) >= cos_max {
+                    pdf
+                } else {
+                    0.0
+                }
+            }
+            Target::Disk { center, frame, radius } => {
+                let cos = dir.dot(frame.n);
+                let t = (center - x).dot(frame.n) / cos;
+                if !(t > 0.0) || !t.is_finite() || (x + t * dir).distance_squared(center) > radius * radius {
+                    return 0.0;
+                }
+                let pdf = t * t / (cos.abs() * PI * radius * radius);
+                if pdf.is_finite() {
+                    pdf
+                } else {
+                    0.0
+                }
+            }
+        }
     }
 }
 
@@ -73,14 +129,16 @@ mod tests {
     use crate::sampling::{next_2d, stream, uniform_cone, Domain};
     use rand::RngExt;
 
-    fn spheres() -> Vec<(Vec3, f32)> {
+    fn spheres() -> Vec<Aim> {
         vec![
-            (Vec3::new(0.0, 0.0, 2.0), 0.5),
-            (Vec3::new(0.4, 0.0, 2.5), 0.7),
+            Aim::Sphere(Vec3::new(0.0, 0.0, 2.0), 0.5),
+            Aim::Sphere(Vec3::new(0.4, 0.0, 2.5), 0.7),
+            // A disk seen at a slant, overlapping the second sphere's cone.
+            Aim::Disk(Vec3::new(0.8, 0.3, 2.0), Vec3::new(0.3, 0.2, -1.0).normalize(), 0.9),
             // Below the horizon: never aimed at.
-            (Vec3::new(0.0, 0.0, -3.0), 1.0),
+            Aim::Sphere(Vec3::new(0.0, 0.0, -3.0), 1.0),
             // Holding the point: left to the cosine rays.
-            (Vec3::new(0.1, 0.0, 0.0), 1.0),
+            Aim::Disk(Vec3::new(0.1, 0.0, 0.0), Vec3::Z, 1.0),
         ]
     }
 
@@ -88,10 +146,10 @@ mod tests {
     fn only_targets_above_the_horizon_and_not_around_the_point_are_aimed_at() {
         let mut cones = AimCones::default();
         assert!(cones.prepare(spheres().into_iter(), Vec3::ZERO, Vec3::Z));
-        assert_eq!(cones.cones.len(), 2);
-        assert!(!cones.prepare(spheres().into_iter().skip(2), Vec3::ZERO, Vec3::Z));
+        assert_eq!(cones.targets.len(), 3);
+        assert!(!cones.prepare(spheres().into_iter().skip(3), Vec3::ZERO, Vec3::Z));
         // A cone that grazes the horizon from below still counts.
-        let grazing = [(Vec3::new(2.0, 0.0, -0.1), 0.5)];
+        let grazing = [Aim::Sphere(Vec3::new(2.0, 0.0, -0.1), 0.5)];
         assert!(cones.prepare(grazing.into_iter(), Vec3::ZERO, Vec3::Z));
     }
 

@@ -16,7 +16,7 @@
 //! Gather rays that reach a light (directly or through mirrors and glass)
 //! add nothing: those paths belong to the first two rows.
 
-use super::aim::AimCones;
+use super::aim::{Aim, AimCones};
 use super::{direct_light, Context, Integrator, Part};
 use crate::material::{Branch, Branches, Lobe, Material, Transport};
 use crate::math::{Color, Frame, Ray};
@@ -41,6 +41,10 @@ const MAX_SPECULAR_DEPTH: u32 = 24;
 /// this (cosine) of its own: the same plane, or a curved surface's nearby
 /// point.
 const REUSE_NORMAL_COSINE: f32 = 0.999;
+
+/// A bright spot whose cap is at most this deep, relative to its radius,
+/// is aimed at as a flat disk.
+const SHALLOW_SPOT: f32 = 0.05;
 
 /// The fractional part of the golden ratio: a sequence stepping by it
 /// fills [0, 1) evenly at every length.
@@ -293,8 +297,7 @@ impl PhotonIntegrator<'_> {
             return Color::ZERO;
         }
         let aims = self.settings.aimed_gather_rays.min(count - 1);
-        let aimed =
-            if aims > 0 && sh.thread.cones.prepare(self.aim_spheres(hit.point), hit.point, n) { aims } else { 0 };
+        let aimed = if aims > 0 && sh.thread.cones.prepare(self.aims(hit.point), hit.point, n) { aims } else { 0 };
         let cosine = count - aimed;
         let frame = Frame::from_normal(n);
         // Each ray, cosine or aimed, weighed by the balance heuristic:
@@ -327,10 +330,19 @@ impl PhotonIntegrator<'_> {
     }
 
     /// What final gathering aims at: the mirror and glass objects' bounding
-    /// spheres and the bright spots' that face `x`.
-    fn aim_spheres(&self, x: glam::Vec3) -> impl Iterator<Item = (glam::Vec3, f32)> + '_ {
-        let targets = self.scene.specular_targets().iter().map(|t| (t.center, t.radius));
-        targets.chain(self.spots.iter().filter(move |s| s.faces(x)).map(|s| (s.center, s.radius)))
+    /// spheres, and the bright spots that face `x`: a flat or shallow one's
+    /// disk, a curved one's bounding sphere (either is an unbiased choice,
+    /// the weights use the pdf of what was sampled; the disk follows a
+    /// shallow spot more closely).
+    fn aims(&self, x: glam::Vec3) -> impl Iterator<Item = Aim> + '_ {
+        let targets = self.scene.specular_targets().iter().map(|t| Aim::Sphere(t.center, t.radius));
+        targets.chain(self.spots.iter().filter(move |s| s.faces(x)).map(|s| {
+            if s.behind <= SHALLOW_SPOT * s.radius && s.normal != glam::Vec3::ZERO {
+                Aim::Disk(s.center, s.normal, s.radius)
+            } else {
+                Aim::Sphere(s.center, s.radius)
+            }
+        }))
     }
 
     /// Radiance arriving along a gather ray that left a non-specular lobe
