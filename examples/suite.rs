@@ -289,7 +289,8 @@ fn report(rows: &[Row], suite: &[SuiteScene], seconds: f64) -> String {
             );
         }
     }
-    let _ = writeln!(s, "\n## The scenes\n\nEach picture: photonmap's default render (reduced to 200 x 200) | the reference | the signed difference (red: photonmap brighter, blue: darker).\n");
+    let _ = writeln!(s, "\n{}", below_noise(rows, seconds));
+    let _ = writeln!(s, "## The scenes\n\nEach picture: photonmap's default render (reduced to 200 x 200) | the reference | the signed difference (red: photonmap brighter, blue: darker).\n");
     for r in rows {
         let comment = suite
             .iter()
@@ -335,4 +336,42 @@ fn csv(rows: &[Row]) -> String {
         }
     }
     s
+}
+
+/// What an RMSE of zero means, and for each such entry the least ratio
+/// the reference allows: Mitsuba's error over the reference's noise.
+fn below_noise(rows: &[Row], seconds: f64) -> String {
+    let mut bounds = Vec::new();
+    let timed = format!("{seconds:.0} s");
+    for r in rows {
+        let runs = [
+            ("default", Some(&r.classic), r.mitsuba_classic.as_ref()),
+            (timed.as_str(), r.progressive.as_ref(), r.mitsuba_progressive.as_ref()),
+        ];
+        for (run, p, m) in runs {
+            let (Some(p), Some(m)) = (p, m) else { continue };
+            let bound = |ours: f64, theirs: f64, noise: Option<f64>| match noise {
+                Some(n) if ours == 0.0 && n > 0.0 => Some(format!("{:.1}x", theirs / n)),
+                _ => None,
+            };
+            let whole = bound(p.rmse, m.rmse, r.noise.0);
+            let caustic = bound(p.caustic_rmse, m.caustic_rmse, r.noise.1);
+            if whole.is_some() || caustic.is_some() {
+                let at_least = |b: Option<String>, what: &str| b.map(|b| format!("{b} {what}"));
+                let parts: Vec<String> =
+                    [at_least(whole, "whole"), at_least(caustic, "caustic window")].into_iter().flatten().collect();
+                bounds.push(format!("{} {run}: at least {}", r.name, parts.join(", ")));
+            }
+        }
+    }
+    let mut text = String::from(
+        "An RMSE of 0.00000 and a ratio \"—\": photonmap's error is below the reference's own noise and cannot be \
+         measured against it; Mitsuba's error over the reference's noise bounds the ratio from below",
+    );
+    if bounds.is_empty() {
+        text.push_str(".\n");
+    } else {
+        text.push_str(&format!(" ({}).\n", bounds.join("; ")));
+    }
+    text
 }
