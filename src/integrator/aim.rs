@@ -39,12 +39,12 @@ enum Target {
 /// The targets a gathering point can see above its horizon, kept by a
 /// thread between points (no allocation per point).
 #[derive(Default)]
-pub struct AimCones {
+pub struct AimTargets {
     x: Vec3,
     targets: Vec<Target>,
 }
 
-impl AimCones {
+impl AimTargets {
     /// The targets, from `x` on a surface facing `n`, that reach above its
     /// horizon (judged by their bounding spheres); false where there are
     /// none. A target whose bounding sphere holds `x` (a cone wider than
@@ -144,31 +144,31 @@ mod tests {
 
     #[test]
     fn only_targets_above_the_horizon_and_not_around_the_point_are_aimed_at() {
-        let mut cones = AimCones::default();
-        assert!(cones.prepare(spheres().into_iter(), Vec3::ZERO, Vec3::Z));
-        assert_eq!(cones.targets.len(), 3);
-        assert!(!cones.prepare(spheres().into_iter().skip(3), Vec3::ZERO, Vec3::Z));
+        let mut targets = AimTargets::default();
+        assert!(targets.prepare(spheres().into_iter(), Vec3::ZERO, Vec3::Z));
+        assert_eq!(targets.targets.len(), 3);
+        assert!(!targets.prepare(spheres().into_iter().skip(3), Vec3::ZERO, Vec3::Z));
         // A cone that grazes the horizon from below still counts.
         let grazing = [Aim::Sphere(Vec3::new(2.0, 0.0, -0.1), 0.5)];
-        assert!(cones.prepare(grazing.into_iter(), Vec3::ZERO, Vec3::Z));
+        assert!(targets.prepare(grazing.into_iter(), Vec3::ZERO, Vec3::Z));
     }
 
     /// The pdf integrates to one over the sphere, and samples land where it
     /// is positive: a Monte Carlo estimate of 1 from uniform directions.
     #[test]
     fn the_mixture_pdf_is_a_density_of_the_samples() {
-        let mut cones = AimCones::default();
-        cones.prepare(spheres().into_iter(), Vec3::ZERO, Vec3::Z);
+        let mut targets = AimTargets::default();
+        targets.prepare(spheres().into_iter(), Vec3::ZERO, Vec3::Z);
         let mut rng = stream(7, Domain::Camera, 0);
         let n = 400_000;
-        let integral: f64 = (0..n).map(|_| cones.pdf(uniform_cone(next_2d(&mut rng), -1.0)) as f64).sum::<f64>()
+        let integral: f64 = (0..n).map(|_| targets.pdf(uniform_cone(next_2d(&mut rng), -1.0)) as f64).sum::<f64>()
             * 4.0
             * std::f64::consts::PI
             / n as f64;
         assert!((integral - 1.0).abs() < 0.02, "{integral}");
         for _ in 0..10_000 {
-            let d = cones.sample(rng.random(), next_2d(&mut rng));
-            assert!(cones.pdf(d) > 0.0, "{d}");
+            let d = targets.sample(rng.random(), next_2d(&mut rng));
+            assert!(targets.pdf(d) > 0.0, "{d}");
             assert!((d.length() - 1.0).abs() < 1e-5);
         }
     }

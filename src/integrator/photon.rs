@@ -16,7 +16,7 @@
 //! Gather rays that reach a light (directly or through mirrors and glass)
 //! add nothing: those paths belong to the first two rows.
 
-use super::aim::{Aim, AimCones};
+use super::aim::{Aim, AimTargets};
 use super::{direct_light, Context, Integrator, Part};
 use crate::material::{Branch, Branches, Lobe, Material, Transport};
 use crate::math::{Color, Frame, Ray};
@@ -95,7 +95,7 @@ pub struct PendingRead {
 pub struct PhotonThread {
     scratch: Scratch,
     pending: Vec<PendingRead>,
-    cones: AimCones,
+    aims: AimTargets,
 }
 
 /// What a pixel's samples share: its last caustic estimate, where it was
@@ -106,7 +106,7 @@ pub struct PhotonPixel {
     caustic: Option<CausticMemo>,
     /// Where the pixel's aimed gather rays are in their choice of cone: a
     /// golden-ratio sequence from a random start, so that a pixel's few
-    /// aimed rays spread over the cones its points see instead of
+    /// aimed rays spread over the targets its points see instead of
     /// repeating one (each choice on its own is still uniform).
     aim_pick: Option<f32>,
 }
@@ -297,7 +297,7 @@ impl PhotonIntegrator<'_> {
             return Color::ZERO;
         }
         let aims = self.settings.aimed_gather_rays.min(count - 1);
-        let aimed = if aims > 0 && sh.thread.cones.prepare(self.aims(hit.point), hit.point, n) { aims } else { 0 };
+        let aimed = if aims > 0 && sh.thread.aims.prepare(self.aims(hit.point), hit.point, n) { aims } else { 0 };
         let cosine = count - aimed;
         let frame = Frame::from_normal(n);
         // Each ray, cosine or aimed, weighed by the balance heuristic:
@@ -314,7 +314,7 @@ impl PhotonIntegrator<'_> {
                     None => sh.ctx.rng.random::<f32>(),
                 };
                 sh.pixel.aim_pick = Some((pick + GOLDEN_RATIO_FRACTION).fract());
-                sh.thread.cones.sample(pick, next_2d(sh.ctx.rng))
+                sh.thread.aims.sample(pick, next_2d(sh.ctx.rng))
             };
             let cos = dir.dot(n);
             // About a shading normal a gather ray may point into the
@@ -322,7 +322,7 @@ impl PhotonIntegrator<'_> {
             if !(cos > 0.0) || (hit.shading_normal != hit.normal && !hit.leaves_as(-n, dir, true)) {
                 continue;
             }
-            let c = if aimed == 0 { 1.0 / nc } else { cos / (nc * cos + na * PI * sh.thread.cones.pdf(dir)) };
+            let c = if aimed == 0 { 1.0 / nc } else { cos / (nc * cos + na * PI * sh.thread.aims.pdf(dir)) };
             let (ray, dep) = hit.spawn(dir);
             sum += c * self.gather(ray, dep, Lobe::Diffuse, w * rho * c, sh);
         }

@@ -5,7 +5,7 @@
 use super::facing::FacingTrees;
 use super::map::{bounds, PhotonMap, Scratch, NORMAL_COSINE};
 use super::spots::SpotPoint;
-use super::{prefetch, quantize_normal};
+use super::{normal_times_127, prefetch, quantize_normal};
 use crate::math::Color;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -60,11 +60,11 @@ struct CachePoint {
 
 impl CachePoint {
     fn faces(&self, n: Vec3) -> bool {
-        Vec3::new(self.normal[0] as f32, self.normal[1] as f32, self.normal[2] as f32).dot(n) >= NORMAL_COSINE * 127.0
+        normal_times_127(self.normal).dot(n) >= NORMAL_COSINE * 127.0
     }
 
     fn normal(&self) -> Vec3 {
-        Vec3::new(self.normal[0] as f32, self.normal[1] as f32, self.normal[2] as f32) / 127.0
+        normal_times_127(self.normal) / 127.0
     }
 }
 

@@ -53,7 +53,7 @@ impl Photon {
     }
 
     pub fn surface_normal(&self) -> Vec3 {
-        Vec3::new(self.normal[0] as f32, self.normal[1] as f32, self.normal[2] as f32) / 127.0
+        normal_times_127(self.normal) / 127.0
     }
 }
 
@@ -61,6 +61,11 @@ impl Photon {
 pub fn quantize_normal(n: Vec3) -> [i8; 4] {
     let q = (n * 127.0).clamp(Vec3::splat(-127.0), Vec3::splat(127.0));
     [q.x.round() as i8, q.y.round() as i8, q.z.round() as i8, 0]
+}
+
+/// A [`quantize_normal`] code as the vector it stands for, times 127.
+pub(crate) fn normal_times_127(q: [i8; 4]) -> Vec3 {
+    Vec3::new(q[0] as f32, q[1] as f32, q[2] as f32)
 }
 
 /// A hint to the processor to bring `value`'s cache line in; nothing else.
