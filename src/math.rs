@@ -35,7 +35,7 @@ impl Ray {
 }
 
 /// An orthonormal frame `(s, t, n)`: local z is the normal.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame {
     pub s: Vec3,
     pub t: Vec3,

@@ -6,55 +6,60 @@
 //! cosine-distributed gather ray finds it rarely and then carries a large
 //! value, a bright speckle in an otherwise smooth image. A few gather rays
 //! are therefore aimed: uniformly in the cone of each mirror or glass
-//! object's bounding sphere (the caustic photons' targets), and uniformly
-//! over the disk that bounds each flat bright spot in its plane. Every
+//! object's bounding sphere (the caustic photons' targets), and at points
+//! of each flat bright spot's plane drawn from its irradiance there
+//! ([`PatchMap`]). Every
 //! gather ray, cosine or aimed, is weighed by the balance heuristic (Veach
 //! 1997, multi-sample model): f cos / (n_cos p_cos + n_aim p_aim). No light
 //! is lost or counted twice, whatever the targets hold.
 
 use crate::math::Frame;
-use crate::sampling::{concentric_disk, cone_to_sphere, uniform_cone, uniform_cone_pdf};
+use crate::photon::spots::PatchMap;
+use crate::sampling::{cone_to_sphere, uniform_cone, uniform_cone_pdf};
 use glam::{Vec2, Vec3};
-use std::f32::consts::PI;
 
 /// What final gathering aims at.
 #[derive(Clone, Copy, Debug)]
-pub enum Aim {
+pub enum Aim<'a> {
     /// A sphere (centre, radius): directions uniform in its cone.
     Sphere(Vec3, f32),
-    /// A flat disk (centre, unit normal, radius): points uniform on it. A
-    /// flat bright spot (a sunlit patch on a floor) seen from a wall at a
-    /// grazing angle fills a few times less of its bounding sphere's cone
-    /// than of the cone's directions aimed at its disk.
-    Disk(Vec3, Vec3, f32),
+    /// A flat bright spot (its map, its radius): points of its plane drawn
+    /// from its irradiance. A sunlit patch seen from a wall at a grazing
+    /// angle fills a few times less of its bounding sphere's cone than of
+    /// the directions towards its plane, and of those only the bright ones
+    /// carry light.
+    Patch(&'a PatchMap, f32),
 }
 
 /// One target as seen from the gathering point.
 #[derive(Clone, Copy, Debug)]
-enum Target {
+enum Target<'a> {
     Cone { axis: Vec3, cos_max: f32, pdf: f32 },
-    Disk { center: Vec3, frame: Frame, radius: f32 },
+    Patch(&'a PatchMap),
 }
 
 /// The targets a gathering point can see above its horizon, kept by a
 /// thread between points (no allocation per point).
 #[derive(Default)]
-pub struct AimTargets {
+pub struct AimTargets<'a> {
     x: Vec3,
-    targets: Vec<Target>,
+    targets: Vec<Target<'a>>,
 }
 
-impl AimTargets {
+impl<'a> AimTargets<'a> {
     /// The targets, from `x` on a surface facing `n`, that reach above its
     /// horizon (judged by their bounding spheres); false where there are
     /// none. A target whose bounding sphere holds `x` (a cone wider than
     /// the hemisphere) is left to the cosine rays: aiming at it would only
     /// repeat them.
-    pub fn prepare(&mut self, aims: impl Iterator<Item = Aim>, x: Vec3, n: Vec3) -> bool {
+    pub fn prepare(&mut self, aims: impl Iterator<Item = Aim<'a>>, x: Vec3, n: Vec3) -> bool {
         self.targets.clear();
         self.x = x;
         for aim in aims {
-            let (Aim::Sphere(center, radius) | Aim::Disk(center, _, radius)) = aim;
+            let (center, radius) = match aim {
+                Aim::Sphere(center, radius) => (center, radius),
+                Aim::Patch(map, radius) => (map.center(), radius),
+            };
             let (axis, cos_max) = cone_to_sphere(x, center, radius);
             if !(cos_max > 0.0) {
                 continue;
@@ -65,7 +70,7 @@ impl AimTargets {
             }
             self.targets.push(match aim {
                 Aim::Sphere(..) => Target::Cone { axis, cos_max, pdf: uniform_cone_pdf(cos_max) },
-                Aim::Disk(center, normal, radius) => Target::Disk { center, frame: Frame::from_normal(normal), radius },
+                Aim::Patch(map, _) => Target::Patch(map),
             });
         }
         !self.targets.is_empty()
@@ -78,10 +83,7 @@ impl AimTargets {
             Target::Cone { axis, cos_max, .. } => {
                 Frame::from_normal(axis).to_world(uniform_cone(u, cos_max)).normalize()
             }
-            Target::Disk { center, frame, radius } => {
-                let d = concentric_disk(u) * radius;
-                (center + frame.to_world(Vec3::new(d.x, d.y, 0.0)) - self.x).normalize_or(frame.n)
-            }
+            Target::Patch(map) => (map.sample(u) - self.x).normalize_or(map.normal()),
         }
     }
 
@@ -93,10 +95,10 @@ impl AimTargets {
     }
 }
 
-impl Target {
+impl Target<'_> {
     /// The pdf per unit solid angle of a direction uniform in the cone, or
-    /// towards a point uniform on the disk (area pdf 1 / (pi r^2), times
-    /// distance^2 / cos at the disk).
+    /// towards a point of the patch's plane (its area pdf there, times
+    /// distance^2 / cos).
     fn pdf(&self, x: Vec3, dir: Vec3) -> f32 {
         match *self {
             Target::Cone { axis, cos_max, pdf } => {
@@ -106,13 +108,13 @@ impl Target {
                     0.0
                 }
             }
-            Target::Disk { center, frame, radius } => {
-                let cos = dir.dot(frame.n);
-                let t = (center - x).dot(frame.n) / cos;
-                if !(t > 0.0) || !t.is_finite() || (x + t * dir).distance_squared(center) > radius * radius {
+            Target::Patch(map) => {
+                let cos = dir.dot(map.normal());
+                let t = (map.center() - x).dot(map.normal()) / cos;
+                if !(t > 0.0) || !t.is_finite() {
                     return 0.0;
                 }
-                let pdf = t * t / (cos.abs() * PI * radius * radius);
+                let pdf = map.area_pdf(x + t * dir) * t * t / cos.abs();
                 if pdf.is_finite() {
                     pdf
                 } else {
@@ -129,25 +131,33 @@ mod tests {
     use crate::sampling::{next_2d, stream, uniform_cone, Domain};
     use rand::RngExt;
 
-    fn spheres() -> Vec<Aim> {
+    /// A flat spot's map, slanted: bright on a band across it, dim
+    /// elsewhere.
+    fn patch() -> PatchMap {
+        let (center, normal) = (Vec3::new(0.8, 0.3, 2.0), Vec3::new(0.3, 0.2, -1.0).normalize());
+        PatchMap::build(center, normal, 0.9, |x| if (x - center).x.abs() < 0.2 { 50.0 } else { 0.5 }).unwrap()
+    }
+
+    fn spheres(patch: &PatchMap) -> Vec<Aim<'_>> {
         vec![
             Aim::Sphere(Vec3::new(0.0, 0.0, 2.0), 0.5),
             Aim::Sphere(Vec3::new(0.4, 0.0, 2.5), 0.7),
-            // A disk seen at a slant, overlapping the second sphere's cone.
-            Aim::Disk(Vec3::new(0.8, 0.3, 2.0), Vec3::new(0.3, 0.2, -1.0).normalize(), 0.9),
+            // A slanted patch, overlapping the second sphere's cone.
+            Aim::Patch(patch, 0.9),
             // Below the horizon: never aimed at.
             Aim::Sphere(Vec3::new(0.0, 0.0, -3.0), 1.0),
             // Holding the point: left to the cosine rays.
-            Aim::Disk(Vec3::new(0.1, 0.0, 0.0), Vec3::Z, 1.0),
+            Aim::Sphere(Vec3::new(0.1, 0.0, 0.0), 1.0),
         ]
     }
 
     #[test]
     fn only_targets_above_the_horizon_and_not_around_the_point_are_aimed_at() {
+        let patch = patch();
         let mut targets = AimTargets::default();
-        assert!(targets.prepare(spheres().into_iter(), Vec3::ZERO, Vec3::Z));
+        assert!(targets.prepare(spheres(&patch).into_iter(), Vec3::ZERO, Vec3::Z));
         assert_eq!(targets.targets.len(), 3);
-        assert!(!targets.prepare(spheres().into_iter().skip(3), Vec3::ZERO, Vec3::Z));
+        assert!(!targets.prepare(spheres(&patch).into_iter().skip(3), Vec3::ZERO, Vec3::Z));
         // A cone that grazes the horizon from below still counts.
         let grazing = [Aim::Sphere(Vec3::new(2.0, 0.0, -0.1), 0.5)];
         assert!(targets.prepare(grazing.into_iter(), Vec3::ZERO, Vec3::Z));
@@ -157,10 +167,11 @@ mod tests {
     /// is positive: a Monte Carlo estimate of 1 from uniform directions.
     #[test]
     fn the_mixture_pdf_is_a_density_of_the_samples() {
+        let patch = patch();
         let mut targets = AimTargets::default();
-        targets.prepare(spheres().into_iter(), Vec3::ZERO, Vec3::Z);
+        targets.prepare(spheres(&patch).into_iter(), Vec3::ZERO, Vec3::Z);
         let mut rng = stream(7, Domain::Camera, 0);
-        let n = 400_000;
+        let n = 1_000_000;
         let integral: f64 = (0..n).map(|_| targets.pdf(uniform_cone(next_2d(&mut rng), -1.0)) as f64).sum::<f64>()
             * 4.0
             * std::f64::consts::PI

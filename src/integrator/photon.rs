@@ -42,10 +42,6 @@ const MAX_SPECULAR_DEPTH: u32 = 24;
 /// point.
 const REUSE_NORMAL_COSINE: f32 = 0.999;
 
-/// A bright spot whose cap is at most this deep, relative to its radius,
-/// is aimed at as a flat disk.
-const SHALLOW_SPOT: f32 = 0.05;
-
 /// The fractional part of the golden ratio: a sequence stepping by it
 /// fills [0, 1) evenly at every length.
 const GOLDEN_RATIO_FRACTION: f32 = 0.618_034;
@@ -92,10 +88,10 @@ pub struct PendingRead {
 /// What a thread keeps between camera rays: scratch space for the map's
 /// searches and the reads left for later.
 #[derive(Default)]
-pub struct PhotonThread {
+pub struct PhotonThread<'a> {
     scratch: Scratch,
     pending: Vec<PendingRead>,
-    aims: AimTargets,
+    aims: AimTargets<'a>,
 }
 
 /// What a pixel's samples share: its last caustic estimate, where it was
@@ -121,9 +117,9 @@ struct CausticMemo {
 
 /// A camera sample as the estimator sees it: the common context and this
 /// integrator's own thread and pixel state.
-struct Shade<'s, 'r> {
+struct Shade<'s, 'r, 'a> {
     ctx: &'s mut Context<'r>,
-    thread: &'s mut PhotonThread,
+    thread: &'s mut PhotonThread<'a>,
     pixel: &'s mut PhotonPixel,
 }
 
@@ -136,8 +132,8 @@ pub struct PhotonIntegrator<'a> {
     pub settings: PhotonEstimator,
 }
 
-impl Integrator for PhotonIntegrator<'_> {
-    type Thread = PhotonThread;
+impl<'a> Integrator for PhotonIntegrator<'a> {
+    type Thread = PhotonThread<'a>;
     type Pixel = PhotonPixel;
 
     fn radiance(
@@ -145,7 +141,7 @@ impl Integrator for PhotonIntegrator<'_> {
         ray: Ray,
         part: Part,
         ctx: &mut Context,
-        thread: &mut PhotonThread,
+        thread: &mut PhotonThread<'a>,
         pixel: &mut PhotonPixel,
     ) -> Color {
         self.trace(ray, None, 0, part, Color::ONE, &mut Shade { ctx, thread, pixel })
@@ -153,7 +149,7 @@ impl Integrator for PhotonIntegrator<'_> {
 
     /// Finds every read's cell first (each cell's slot was fetched when its
     /// gather ray hit, and this starts fetching the points), then reads.
-    fn finish(&self, ctx: &mut Context, thread: &mut PhotonThread, _: &mut PhotonPixel) -> Color {
+    fn finish(&self, ctx: &mut Context, thread: &mut PhotonThread<'a>, _: &mut PhotonPixel) -> Color {
         let pending = &mut thread.pending;
         for p in pending.iter_mut() {
             p.cell = self.cache.locate(p.point);
@@ -170,8 +166,16 @@ impl Integrator for PhotonIntegrator<'_> {
 /// In the functions below, `w` is what radiance leaving the current vertex
 /// is multiplied by on its way to the camera: the weight of a read left
 /// for later (see [`PendingRead`]).
-impl PhotonIntegrator<'_> {
-    fn trace(&self, ray: Ray, departure: Option<Departure>, depth: u32, part: Part, w: Color, sh: &mut Shade) -> Color {
+impl<'a> PhotonIntegrator<'a> {
+    fn trace(
+        &self,
+        ray: Ray,
+        departure: Option<Departure>,
+        depth: u32,
+        part: Part,
+        w: Color,
+        sh: &mut Shade<'_, '_, 'a>,
+    ) -> Color {
         sh.ctx.counters.rays += 1;
         let Some(hit) = self.scene.intersect(&ray, departure) else {
             return Color::ZERO;
@@ -210,12 +214,12 @@ impl PhotonIntegrator<'_> {
         depth: u32,
         part: Part,
         w: Color,
-        sh: &mut Shade,
+        sh: &mut Shade<'_, '_, 'a>,
     ) -> Color {
         if depth >= MAX_SPECULAR_DEPTH {
             return Color::ZERO;
         }
-        let follow = |s: &Self, b: &Branch, w: Color, sh: &mut Shade| {
+        let follow = |s: &Self, b: &Branch, w: Color, sh: &mut Shade<'_, '_, 'a>| {
             let (next, dep) = hit.spawn(frame.to_world(b.wi).normalize());
             b.scale * s.trace(next, Some(dep), depth + 1, part, w * b.scale, sh)
         };
@@ -236,7 +240,7 @@ impl PhotonIntegrator<'_> {
         frame: &Frame,
         wo: glam::Vec3,
         w: Color,
-        sh: &mut Shade,
+        sh: &mut Shade<'_, '_, 'a>,
     ) -> Color {
         let n = frame.n;
         let brdf = |w: glam::Vec3| material.eval(wo, frame.to_local(w));
@@ -262,7 +266,7 @@ impl PhotonIntegrator<'_> {
     }
 
     /// Light → specular+ → x: the caustic map.
-    fn caustic(&self, hit: &Hit, n: glam::Vec3, rho: Color, sh: &mut Shade) -> Color {
+    fn caustic(&self, hit: &Hit, n: glam::Vec3, rho: Color, sh: &mut Shade<'_, '_, 'a>) -> Color {
         if self.caustic.is_empty() {
             return Color::ZERO;
         }
@@ -291,7 +295,7 @@ impl PhotonIntegrator<'_> {
     ///
     /// Where the point sees a mirror or glass object or a bright spot, some
     /// of the rays are aimed at them ([`super::aim`]).
-    fn indirect(&self, hit: &Hit, n: glam::Vec3, rho: Color, w: Color, sh: &mut Shade) -> Color {
+    fn indirect(&self, hit: &Hit, n: glam::Vec3, rho: Color, w: Color, sh: &mut Shade<'_, '_, 'a>) -> Color {
         let count = self.settings.gather_rays;
         if count == 0 || self.cache.is_empty() {
             return Color::ZERO;
@@ -330,18 +334,15 @@ impl PhotonIntegrator<'_> {
     }
 
     /// What final gathering aims at: the mirror and glass objects' bounding
-    /// spheres, and the bright spots that face `x`: a flat or shallow one's
-    /// disk, a curved one's bounding sphere (either is an unbiased choice,
-    /// the weights use the pdf of what was sampled; the disk follows a
-    /// shallow spot more closely).
-    fn aims(&self, x: glam::Vec3) -> impl Iterator<Item = Aim> + '_ {
+    /// spheres, and the bright spots that face `x`: a flat one's irradiance
+    /// over its plane, a curved one's bounding sphere (either is an
+    /// unbiased choice, the weights use the pdf of what was sampled; the
+    /// map follows a flat spot's light closely).
+    fn aims(&self, x: glam::Vec3) -> impl Iterator<Item = Aim<'a>> + 'a {
         let targets = self.scene.specular_targets().iter().map(|t| Aim::Sphere(t.center, t.radius));
-        targets.chain(self.spots.iter().filter(move |s| s.faces(x)).map(|s| {
-            if s.behind <= SHALLOW_SPOT * s.radius && s.normal != glam::Vec3::ZERO {
-                Aim::Disk(s.center, s.normal, s.radius)
-            } else {
-                Aim::Sphere(s.center, s.radius)
-            }
+        targets.chain(self.spots.iter().filter(move |s| s.faces(x)).map(|s| match &s.patch {
+            Some(map) => Aim::Patch(map, s.radius),
+            None => Aim::Sphere(s.center, s.radius),
         }))
     }
 
@@ -354,7 +355,7 @@ impl PhotonIntegrator<'_> {
     /// or glass counts only where the last non-specular vertex was glossy:
     /// a diffuse one's is the caustic map's, and light met straight from a
     /// non-specular vertex is its direct estimate's (notes/method.md).
-    fn gather(&self, mut ray: Ray, mut dep: Departure, mut from: Lobe, w: Color, sh: &mut Shade) -> Color {
+    fn gather(&self, mut ray: Ray, mut dep: Departure, mut from: Lobe, w: Color, sh: &mut Shade<'_, '_, 'a>) -> Color {
         let mut weight = Color::ONE;
         // A mirror or glass vertex since the last non-specular one.
         let mut specular = false;
@@ -418,7 +419,14 @@ impl PhotonIntegrator<'_> {
     /// with weight `w` times `weight` (`w`: what the radiance leaving along
     /// the gather ray is multiplied by on its way to the camera) and its
     /// cell's slot being fetched.
-    fn read(&self, point: glam::Vec3, normal: glam::Vec3, weight: Color, w: Color, sh: &mut Shade) -> Color {
+    fn read(
+        &self,
+        point: glam::Vec3,
+        normal: glam::Vec3,
+        weight: Color,
+        w: Color,
+        sh: &mut Shade<'_, '_, 'a>,
+    ) -> Color {
         if weight == Color::ZERO || self.cache.is_empty() {
             return Color::ZERO;
         }
@@ -431,7 +439,7 @@ impl PhotonIntegrator<'_> {
         }
     }
 
-    fn checked(&self, c: Color, estimator: &'static str, sh: &mut Shade) -> Color {
+    fn checked(&self, c: Color, estimator: &'static str, sh: &mut Shade<'_, '_, 'a>) -> Color {
         sh.ctx.checked(c, estimator)
     }
 }

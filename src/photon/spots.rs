@@ -7,7 +7,8 @@
 //! isolated bright pixel. Final gathering aims a few rays at the spots
 //! (`integrator::aim`), weighed so that no light is counted twice.
 
-use glam::{IVec3, Vec3};
+use crate::math::Frame;
+use glam::{IVec3, Vec2, Vec3};
 use std::collections::HashMap;
 
 /// A point is part of a spot where its irradiance exceeds the scene's
@@ -20,6 +21,13 @@ pub const SPOT_CONTRAST: f32 = 8.0;
 /// The brightest spots kept (by power): gather rays choose among those a
 /// point sees, and each costs a cone test per gather ray.
 pub const MAX_SPOTS: usize = 16;
+
+/// A spot whose cap is at most this deep, relative to its radius, is
+/// flat: aimed at through its plane ([`PatchMap`]), not its sphere.
+pub const SHALLOW_SPOT: f32 = 0.05;
+
+/// Cells a side of a flat spot's [`PatchMap`].
+pub const PATCH_CELLS: usize = 32;
 
 /// A point of the irradiance cache as the spots see it.
 #[derive(Clone, Copy, Debug)]
@@ -36,8 +44,9 @@ pub struct SpotPoint {
 
 /// A bright spot: its bounding sphere, the side it is lit from (the mean
 /// of its points' normals), how far behind its mean plane it may still be
-/// seen from, and the power its points stand for.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// seen from, the power its points stand for, and, for a flat spot, its
+/// irradiance over its plane.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Spot {
     pub center: Vec3,
     pub radius: f32,
@@ -47,6 +56,7 @@ pub struct Spot {
     /// half-angle t has mean normal length ~1 - t^2/4 and depth ~r t / 2).
     pub behind: f32,
     pub power: f32,
+    pub patch: Option<PatchMap>,
 }
 
 impl Spot {
@@ -64,11 +74,16 @@ impl Spot {
 /// area-weighted mean irradiance, joined where they face the same way
 /// (dominant axis and sign of the normal) and lie in the same or
 /// neighbouring cells of a grid twice their median radius wide; the
-/// [`MAX_SPOTS`] most powerful, most powerful first.
+/// [`MAX_SPOTS`] most powerful, most powerful first. Each flat one gets
+/// its [`PatchMap`] from `irradiance(x, n)`, the irradiance (mean of the
+/// channels) at `x` on a surface facing `n`.
 ///
 /// `points` is read twice and never held whole (an irradiance cache of
 /// 1e7 photons has ~3 million points): the median needs 8 bytes a point.
-pub fn bright_spots(points: impl Iterator<Item = SpotPoint> + Clone) -> Vec<Spot> {
+pub fn bright_spots(
+    points: impl Iterator<Item = SpotPoint> + Clone,
+    irradiance: impl Fn(Vec3, Vec3) -> f32,
+) -> Vec<Spot> {
     let valid = |p: &SpotPoint| {
         p.position.is_finite() && p.normal.is_finite() && p.irradiance.is_finite() && p.r2.is_finite() && p.r2 > 0.0
     };
@@ -111,17 +126,19 @@ pub fn bright_spots(points: impl Iterator<Item = SpotPoint> + Clone) -> Vec<Spot
         }
     }
     // Per cluster: its box (for the centre), its normals' area-weighted
-    // sum, its area and power.
-    let mut clusters: HashMap<usize, (Vec3, Vec3, Vec3, f32, f32)> = HashMap::new();
+    // sum, its area and power, its positions' area-weighted sum (a point
+    // of its mean plane).
+    let mut clusters: HashMap<usize, (Vec3, Vec3, Vec3, f32, f32, Vec3)> = HashMap::new();
     for (i, p) in hot.iter().enumerate() {
         let root = find(&mut parent, i);
         let r = p.r2.sqrt();
-        let c = clusters.entry(root).or_insert((p.position - r, p.position + r, Vec3::ZERO, 0.0, 0.0));
+        let c = clusters.entry(root).or_insert((p.position - r, p.position + r, Vec3::ZERO, 0.0, 0.0, Vec3::ZERO));
         c.0 = c.0.min(p.position - r);
         c.1 = c.1.max(p.position + r);
         c.2 += p.normal * p.r2;
         c.3 += p.r2;
         c.4 += p.irradiance * p.r2;
+        c.5 += p.position * p.r2;
     }
     let mut radius: HashMap<usize, f32> = HashMap::new();
     for (i, p) in hot.iter().enumerate() {
@@ -133,7 +150,7 @@ pub fn bright_spots(points: impl Iterator<Item = SpotPoint> + Clone) -> Vec<Spot
     }
     let mut spots: Vec<Spot> = clusters
         .iter()
-        .map(|(root, &(lo, hi, normal, area, power))| {
+        .map(|(root, &(lo, hi, normal, area, power, sum))| {
             let spread = (1.0 - normal.length() / area).max(0.0);
             let radius = radius[root];
             Spot {
@@ -142,7 +159,9 @@ pub fn bright_spots(points: impl Iterator<Item = SpotPoint> + Clone) -> Vec<Spot
                 normal: normal.normalize_or_zero(),
                 behind: radius * spread.sqrt(),
                 power,
+                patch: None,
             }
+            .with_patch(sum / area, &irradiance)
         })
         .collect();
     // Ties broken by position: the same spots whatever the hash order.
@@ -153,6 +172,117 @@ pub fn bright_spots(points: impl Iterator<Item = SpotPoint> + Clone) -> Vec<Spot
     });
     spots.truncate(MAX_SPOTS);
     spots
+}
+
+impl Spot {
+    /// Whether the spot is flat: its cap at most [`SHALLOW_SPOT`] of its
+    /// radius deep.
+    pub fn is_flat(&self) -> bool {
+        self.behind <= SHALLOW_SPOT * self.radius && self.normal != Vec3::ZERO
+    }
+
+    /// The spot with its [`PatchMap`], if flat, over the plane through
+    /// `on_plane` facing its normal.
+    fn with_patch(mut self, on_plane: Vec3, irradiance: impl Fn(Vec3, Vec3) -> f32) -> Self {
+        if self.is_flat() {
+            let center = self.center - (self.center - on_plane).dot(self.normal) * self.normal;
+            self.patch = PatchMap::build(center, self.normal, self.radius, |x| irradiance(x, self.normal));
+        }
+        self
+    }
+}
+
+/// A flat spot's irradiance over the square of side 2 r around its centre
+/// in its plane, [`PATCH_CELLS`] cells a side: a piecewise-constant
+/// density over the plane, proportional to the light each cell sends out.
+/// Final gathering aims at points drawn from it: a sunlit patch is a
+/// parallelogram that fills a third of its bounding disk, a caustic's focus
+/// a small part of it, and a point uniform on the disk would mostly meet
+/// the dim floor around them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PatchMap {
+    center: Vec3,
+    frame: Frame,
+    half: f32,
+    /// The cells' cumulative shares, row by row; the last is 1.
+    cdf: Vec<f32>,
+    /// Each cell's density per unit area of the plane.
+    density: Vec<f32>,
+}
+
+impl PatchMap {
+    /// Each cell weighed by the mean of `irradiance` at four points in it;
+    /// None where no cell has any (or the square is degenerate).
+    pub fn build(center: Vec3, normal: Vec3, radius: f32, irradiance: impl Fn(Vec3) -> f32) -> Option<Self> {
+        let frame = Frame::from_normal(normal);
+        let cell = 2.0 * radius / PATCH_CELLS as f32;
+        if !(cell > 0.0) || !cell.is_finite() || !center.is_finite() {
+            return None;
+        }
+        let point = |ix: usize, iy: usize, fx: f32, fy: f32| {
+            let (x, y) = ((ix as f32 + fx) * cell - radius, (iy as f32 + fy) * cell - radius);
+            center + frame.s * x + frame.t * y
+        };
+        let weights: Vec<f64> = (0..PATCH_CELLS * PATCH_CELLS)
+            .map(|i| {
+                let (ix, iy) = (i % PATCH_CELLS, i / PATCH_CELLS);
+                [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)]
+                    .iter()
+                    .map(|&(fx, fy)| irradiance(point(ix, iy, fx, fy)) as f64)
+                    .filter(|e| e.is_finite() && *e > 0.0)
+                    .sum::<f64>()
+            })
+            .collect();
+        let total: f64 = weights.iter().sum();
+        if !(total > 0.0) || !total.is_finite() {
+            return None;
+        }
+        let mut running = 0.0;
+        let mut cdf: Vec<f32> = weights
+            .iter()
+            .map(|w| {
+                running += w;
+                (running / total) as f32
+            })
+            .collect();
+        *cdf.last_mut()? = 1.0;
+        // Each cell's share as the sampling sees it (a share below f32's
+        // resolution is never drawn, and has density zero).
+        let area = cell * cell;
+        let density = (0..cdf.len()).map(|i| (cdf[i] - if i == 0 { 0.0 } else { cdf[i - 1] }) / area).collect();
+        Some(PatchMap { center, frame, half: radius, cdf, density })
+    }
+
+    pub fn center(&self) -> Vec3 {
+        self.center
+    }
+
+    pub fn normal(&self) -> Vec3 {
+        self.frame.n
+    }
+
+    /// A point of the plane drawn from the density (`u` uniform in [0, 1)^2).
+    pub fn sample(&self, u: Vec2) -> Vec3 {
+        let i = self.cdf.partition_point(|&c| c <= u.x).min(self.cdf.len() - 1);
+        let lo = if i == 0 { 0.0 } else { self.cdf[i - 1] };
+        let fx = ((u.x - lo) / (self.cdf[i] - lo)).clamp(0.0, 1.0);
+        let cell = 2.0 * self.half / PATCH_CELLS as f32;
+        let (ix, iy) = (i % PATCH_CELLS, i / PATCH_CELLS);
+        let (x, y) = ((ix as f32 + fx) * cell - self.half, (iy as f32 + u.y) * cell - self.half);
+        self.center + self.frame.s * x + self.frame.t * y
+    }
+
+    /// The density per unit area at `p`, a point of the plane.
+    pub fn area_pdf(&self, p: Vec3) -> f32 {
+        let d = p - self.center;
+        let cell = 2.0 * self.half / PATCH_CELLS as f32;
+        let (x, y) = ((d.dot(self.frame.s) + self.half) / cell, (d.dot(self.frame.t) + self.half) / cell);
+        if !(x >= 0.0 && y >= 0.0 && x < PATCH_CELLS as f32 && y < PATCH_CELLS as f32) {
+            return 0.0;
+        }
+        let (ix, iy) = ((x as usize).min(PATCH_CELLS - 1), (y as usize).min(PATCH_CELLS - 1));
+        self.density[iy * PATCH_CELLS + ix]
+    }
 }
 
 /// The dominant axis and sign of a normal: points on surfaces that face
@@ -215,7 +345,7 @@ mod tests {
                 points.push(SpotPoint { position: x, normal: Vec3::Y, irradiance: e, r2 });
             }
         }
-        let spots = bright_spots(points.iter().copied());
+        let spots = bright_spots(points.iter().copied(), |_, _| 1.0);
         assert_eq!(spots.len(), 2, "{spots:?}");
         // The wider one has the more power.
         assert!(spots[0].center.distance(Vec3::new(7.0, 0.0, 6.0)) < 0.1, "{spots:?}");
@@ -244,17 +374,57 @@ mod tests {
             irradiance: 1.0,
             r2: 1.0,
         }));
-        let spots = bright_spots(points.iter().copied());
+        let spots = bright_spots(points.iter().copied(), |_, _| 1.0);
         assert_eq!(spots.len(), 2, "{spots:?}");
         assert!(spots[0].normal.distance(Vec3::Y) < 1e-5 && spots[1].normal.distance(-Vec3::Y) < 1e-5, "{spots:?}");
+    }
+
+    /// A sunlit parallelogram on a floor: the map's samples land on it
+    /// (over 90% of them, for 28% of the square), its density integrates
+    /// to one, and it is the density of its samples (E[1 / pdf] over the
+    /// samples is the square's area).
+    #[test]
+    fn a_patch_map_draws_points_as_its_density_says() {
+        let lit = |x: Vec3| {
+            let (u, v) = (x.x - 0.5 * x.z, x.z);
+            u.abs() < 0.4 && v.abs() < 0.7
+        };
+        let map = PatchMap::build(Vec3::ZERO, Vec3::Y, 1.0, |x| if lit(x) { 100.0 } else { 1.0 }).unwrap();
+        let mut rng = crate::sampling::stream(3, crate::sampling::Domain::Camera, 0);
+        let n = 200_000;
+        let (mut on_patch, mut inverse) = (0, 0.0f64);
+        for _ in 0..n {
+            let x = map.sample(crate::sampling::next_2d(&mut rng));
+            assert!(x.y.abs() < 1e-6 && x.x.abs() <= 1.0 + 1e-5 && x.z.abs() <= 1.0 + 1e-5, "{x}");
+            let pdf = map.area_pdf(x);
+            assert!(pdf > 0.0, "{x}");
+            inverse += 1.0 / pdf as f64;
+            on_patch += lit(x) as u32;
+        }
+        assert!((inverse / n as f64 - 4.0).abs() < 0.2, "{}", inverse / n as f64);
+        assert!(on_patch as f64 > 0.9 * n as f64, "{on_patch}");
+        let m = 400;
+        let integral: f64 = (0..m * m)
+            .map(|i| {
+                let (a, b) = ((i % m) as f32 + 0.5, (i / m) as f32 + 0.5);
+                map.area_pdf(Vec3::new(2.0 * a / m as f32 - 1.0, 0.0, 2.0 * b / m as f32 - 1.0)) as f64
+            })
+            .sum::<f64>()
+            * 4.0
+            / (m * m) as f64;
+        assert!((integral - 1.0).abs() < 1e-3, "{integral}");
+        assert_eq!(map.area_pdf(Vec3::new(1.5, 0.0, 0.0)), 0.0);
+        assert!(PatchMap::build(Vec3::ZERO, Vec3::Y, 1.0, |_| 0.0).is_none());
     }
 
     #[test]
     fn a_uniform_or_empty_scene_has_no_spots() {
         let point = |position: Vec3, irradiance: f32| SpotPoint { position, normal: Vec3::Y, irradiance, r2: 1.0 };
         let points: Vec<_> = (0..1000).map(|i| point(Vec3::new(i as f32, 0.0, 0.0), 1.0 + (i % 3) as f32)).collect();
-        assert!(bright_spots(points.into_iter()).is_empty());
-        assert!(bright_spots(std::iter::empty()).is_empty());
-        assert!(bright_spots([point(Vec3::NAN, 1.0), point(Vec3::ZERO, f32::INFINITY)].into_iter()).is_empty());
+        assert!(bright_spots(points.into_iter(), |_, _| 1.0).is_empty());
+        assert!(bright_spots(std::iter::empty(), |_, _| 1.0).is_empty());
+        assert!(
+            bright_spots([point(Vec3::NAN, 1.0), point(Vec3::ZERO, f32::INFINITY)].into_iter(), |_, _| 1.0).is_empty()
+        );
     }
 }

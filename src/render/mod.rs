@@ -121,18 +121,19 @@ mod tests {
         let (mut thread, mut reads) = (Default::default(), 0);
         for pixel in 0..48 * 48u64 {
             let ray = camera.ray(pixel as u32 % 48, pixel as u32 / 48, glam::Vec2::splat(0.5));
-            let mut run = |integrator: &crate::integrator::photon::PhotonIntegrator| {
+            // At once, then deferred.
+            let mut out = [(glam::Vec3::ZERO, glam::Vec3::ZERO); 2];
+            for (integrator, out) in [&at_once, &deferred].into_iter().zip(&mut out) {
                 let mut rng = stream(3, Domain::Camera, pixel);
                 let mut ctx = Context { rng: &mut rng, counters: &mut counters, pixel };
                 let mut state = Default::default();
                 let radiance =
                     integrator.radiance(ray, crate::integrator::Part::All, &mut ctx, &mut thread, &mut state);
                 let left = integrator.finish(&mut ctx, &mut thread, &mut state);
-                (radiance, left)
-            };
-            let (a, none_left) = run(&at_once);
+                *out = (radiance, left);
+            }
+            let [(a, none_left), (b, left)] = out;
             assert_eq!(none_left, glam::Vec3::ZERO);
-            let (b, left) = run(&deferred);
             reads += (left != glam::Vec3::ZERO) as u32;
             let resolved = b + left;
             for c in 0..3 {

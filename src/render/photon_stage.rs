@@ -122,7 +122,11 @@ pub fn photon_pass(
     // their disk that lies on their surface.
     let coverage = |x, n, r| scene.disk_coverage(x, n, r, COVERAGE_SAMPLES);
     let cache = IrradianceCache::build_with(&global_map, stride, est.k_global, est.r_global, &coverage);
-    let spots = if settings.aimed_rays() > 0 { bright_spots(cache.spot_points()) } else { Vec::new() };
+    let spots = if settings.aimed_rays() > 0 {
+        bright_spots(cache.spot_points(), |x, n| cache.lookup(x, n).element_sum() / 3.0)
+    } else {
+        Vec::new()
+    };
     stats.cache_time += t.elapsed();
     stats.spots = spots.len();
     stats.global_stored = global_map.len();
