@@ -43,7 +43,8 @@ fn kd_tree_build(c: &mut Criterion) {
             || photons.clone(),
             |p| {
                 let map = PhotonMap::build_for_photon_lookups(p, r_global * GLOBAL_GRID_CELL);
-                black_box(IrradianceCache::build(&map, cache_stride(100), 100, r_global).len())
+                let stride = cache_stride(100, map.len());
+                black_box(IrradianceCache::build(&map, stride, 100, r_global).len())
             },
             BatchSize::LargeInput,
         )

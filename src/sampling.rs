@@ -29,6 +29,7 @@ pub enum Domain {
     GlobalPhotons = 0x0061_0B41,
     CausticPhotons = 0x00CA_05C1,
     EdgeProbes = 0x00ED_6E00,
+    CacheDirect = 0x00CA_D1EC,
 }
 
 /// The random stream of work item `index` in `domain` for run `seed`.

@@ -68,12 +68,12 @@ fn path_tracer_agrees_with_the_reference_within_noise() {
     }
 }
 
-/// Gather rays read the nearest precomputed irradiance, which leans towards
-/// where photons are denser, i.e. brighter: the sparser the cached values,
-/// the brighter the image. With the small k of late progressive passes
-/// (25 here), a fixed stride of 16 (1.6 values per estimate disk) brightened
-/// the image by ~0.5% (+0.45% at the 60th pass); the default stride follows
-/// k (k / 6) and stays within 0.25% of caching at every photon.
+/// Gather rays read the nearest precomputed irradiance: the sparser the
+/// cached values, the further the image from caching at every photon
+/// (with the small k of late progressive passes, 25 here, a stride of 64
+/// left holes between the points and darkened the image by ~4%). The
+/// default stride follows k (k / 6) and stays within 0.25% of caching at
+/// every photon.
 #[test]
 fn the_irradiance_cache_stays_dense_enough_as_k_shrinks() {
     let scene = Scene::tncg15(Eye::One);
@@ -91,9 +91,9 @@ fn the_irradiance_cache_stays_dense_enough_as_k_shrinks() {
         render(&scene, &s, Mode::Quiet).0.mean()
     };
     let every = mean(Some(1));
-    let (auto, sparse) = (mean(None) / every - 1.0, mean(Some(16)) / every - 1.0);
-    eprintln!("mean against stride 1: default {auto:+.4}, stride 16 {sparse:+.4}");
+    let (auto, sparse) = (mean(None) / every - 1.0, mean(Some(64)) / every - 1.0);
+    eprintln!("mean against stride 1: default {auto:+.4}, stride 64 {sparse:+.4}");
     assert!(auto.abs() < 0.0025, "default stride: {auto:+.4}");
-    // The test has power: the sparse cache's lean is visible at this size.
-    assert!(sparse > 0.0035, "stride 16: {sparse:+.4}");
+    // The test has power: a sparse cache's difference is visible at this size.
+    assert!(sparse.abs() > 0.01, "stride 64: {sparse:+.4}");
 }

@@ -53,6 +53,22 @@ pub fn direct_light(
     })
 }
 
+/// Irradiance at `x`, a point on a surface facing `n` (towards the side
+/// light arrives on), straight from the lights: [`direct_light`] of a
+/// Lambertian surface of reflectance 1, times pi. The surface is found
+/// by a short ray down onto it (zero where there is none).
+pub fn direct_irradiance(scene: &Scene, x: Vec3, n: Vec3, count: u32, skip: bool, ctx: &mut Context) -> Color {
+    let height = 1e-4 * (1.0 + x.abs().max_element());
+    let Some(hit) = scene.intersect(&crate::math::Ray::new(x + height * n, -n), None) else {
+        return Color::ZERO;
+    };
+    if hit.t > 2.0 * height {
+        return Color::ZERO;
+    }
+    let brdf = |_: Vec3| Color::splat(std::f32::consts::FRAC_1_PI);
+    std::f32::consts::PI * direct_light(scene, &hit, n, brdf, count, skip, ctx)
+}
+
 /// [`direct_light`] one sample at a time: the reference it must equal.
 pub fn direct_light_one_at_a_time(
     scene: &Scene,

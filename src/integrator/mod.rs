@@ -15,7 +15,7 @@ pub mod path;
 pub mod photon;
 pub mod whitted;
 
-pub use direct::{direct_light, direct_light_one_at_a_time};
+pub use direct::{direct_irradiance, direct_light, direct_light_one_at_a_time};
 
 use crate::math::{Color, Ray};
 use crate::sampling::Rng;

@@ -160,20 +160,23 @@ impl IrradianceCache {
     /// Precomputes irradiance at every `stride`-th photon of `map` from its
     /// `k` nearest within `r_max`.
     pub fn build(map: &PhotonMap, stride: usize, k: usize, r_max: f32) -> Self {
-        Self::build_with(map, stride, k, r_max, &|_, _, _| 1.0)
+        Self::build_with(map, stride, k, r_max, &|_, _, _| 1.0, None)
     }
 
     /// [`Self::build`], each estimate whose disk holds another surface's
     /// photons divided by `coverage(x, n, r)`: the fraction of the disk of
     /// radius r around x, on the plane of normal n, that lies on x's own
     /// surface (at least a quarter, so that a sliver of surface does not
-    /// turn its few photons into a spike).
+    /// turn its few photons into a spike); with `direct`, each plus
+    /// `direct(i, x, n)`, the irradiance straight from the lights at the
+    /// `i`-th point (a map that holds no photon's first hit).
     pub fn build_with(
         map: &PhotonMap,
         stride: usize,
         k: usize,
         r_max: f32,
         coverage: &(dyn Fn(Vec3, Vec3, f32) -> f32 + Sync),
+        direct: Option<&(dyn Fn(u64, Vec3, Vec3) -> Color + Sync)>,
     ) -> Self {
         let stride = stride.max(1);
         // Rayon hands each piece of work it splits off a fresh scratch, and
@@ -190,14 +193,18 @@ impl IrradianceCache {
         let computed: Vec<(CachePoint, f32)> = map
             .spatial_order()
             .step_by(stride)
+            .enumerate()
             .map_init(
                 || Scratch::with_hint(hint),
-                |buf, p| {
+                |buf, (i, p)| {
                     let n = p.surface_normal();
                     let est = map.irradiance_estimate(p.position(), n, k, r_max, buf);
                     let (mut e, r2) = (est.irradiance, est.r2);
                     if est.other_surfaces {
                         e /= coverage(p.position(), n, r2.sqrt()).clamp(0.25, 1.0);
+                    }
+                    if let Some(direct) = direct {
+                        e += direct(i as u64, p.position(), n);
                     }
                     let point = CachePoint {
                         position: p.position().to_array(),

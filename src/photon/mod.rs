@@ -2,8 +2,10 @@
 //!
 //! Two passes fill two maps (Jensen 1996):
 //! * the **global pass** emits photons from the lights with their natural
-//!   (cosine) distribution and stores every diffuse hit in the global map;
-//!   it is read only through the precomputed irradiance of final gathering;
+//!   (cosine) distribution and stores every diffuse hit but a photon's
+//!   first (light straight from a light, which shadow rays find exactly)
+//!   in the global map; it is read only through the precomputed irradiance
+//!   of final gathering, which adds the direct part;
 //! * the **caustic pass** aims photons at the bounding spheres of mirror and
 //!   glass objects (with their power corrected by the sampling pdf, so the
 //!   estimate is unchanged) and stores only the paths light → specular+ →

@@ -307,11 +307,12 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
     let first_specular = bounce_now == 0 && material.is_specular();
     let stop = (false, first_specular);
     if material.diffuse_rho().is_some() {
-        // Light reaching a diffuse surface straight from the light is not
-        // a caustic (shadow rays count it); after a diffuse bounce it is
-        // indirect light (final gathering counts it).
+        // Light reaching a diffuse surface straight from the light is
+        // neither a caustic nor in the global map: shadow rays count it,
+        // at the camera's points and at the irradiance cache's. After a
+        // diffuse bounce it is indirect light (final gathering counts it).
         let caustic = *only_specular_so_far && *specular_bounces > 0;
-        if pass == Pass::Global || caustic {
+        if (pass == Pass::Global && bounce_now > 0) || caustic {
             out.push(Photon::new(hit.point, *power, frame.n));
         }
     }

@@ -117,11 +117,19 @@ pub fn photon_pass(
     );
     stats.tree_time += t.elapsed();
     let t = Instant::now();
-    let stride = settings.cache_stride.unwrap_or_else(|| cache_stride(est.k_global));
+    let stride = settings.cache_stride.unwrap_or_else(|| cache_stride(est.k_global, global_map.len()));
     // Estimates near an edge or a contact are divided by the part of
     // their disk that lies on their surface.
     let coverage = |x, n, r| scene.disk_coverage(x, n, r, COVERAGE_SAMPLES);
-    let cache = IrradianceCache::build_with(&global_map, stride, est.k_global, est.r_global, &coverage);
+    // The global map holds no photon's first hit: the cache adds the
+    // direct light by shadow rays.
+    let direct = |i: u64, x, n| {
+        let mut rng = crate::sampling::stream(seed, crate::sampling::Domain::CacheDirect, i);
+        let mut counters = crate::stats::Counters::default();
+        let mut ctx = crate::integrator::Context { rng: &mut rng, counters: &mut counters, pixel: i };
+        crate::integrator::direct_irradiance(scene, x, n, CACHE_SHADOW_RAYS, settings.skip, &mut ctx)
+    };
+    let cache = IrradianceCache::build_with(&global_map, stride, est.k_global, est.r_global, &coverage, Some(&direct));
     let spots = if settings.aimed_rays() > 0 {
         bright_spots(cache.spot_points(), |x, n| cache.lookup(x, n).element_sum() / 3.0)
     } else {
@@ -135,6 +143,9 @@ pub fn photon_pass(
     stats.map_bytes = global_map.memory_bytes() + caustic_map.memory_bytes();
     Maps { caustic: caustic_map, cache, spots }
 }
+
+/// Shadow rays per area light for a cache point's direct irradiance.
+const CACHE_SHADOW_RAYS: u32 = 16;
 
 /// Rays measuring the part of an estimate's disk that lies on its surface
 /// (where the disk holds another surface's photons).
