@@ -152,6 +152,60 @@ pub fn stratified_2d(index: u32, n: u32, u: Vec2) -> Vec2 {
     .min(Vec2::splat(1.0 - f32::EPSILON * 0.5))
 }
 
+/// A distribution over `0..n` in proportion to non-negative weights,
+/// drawn by inverting its cumulative shares: the lights by power, a bright
+/// spot's cells by irradiance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Discrete {
+    /// Cumulative shares; the last is 1.
+    cdf: Vec<f32>,
+}
+
+impl Discrete {
+    /// None where the weights (a negative or non-finite one counting as
+    /// zero) sum to zero.
+    pub fn new(weights: impl IntoIterator<Item = f64>) -> Option<Self> {
+        let weights: Vec<f64> = weights.into_iter().map(|w| if w.is_finite() && w > 0.0 { w } else { 0.0 }).collect();
+        let total: f64 = weights.iter().sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return None;
+        }
+        let mut running = 0.0;
+        let mut cdf: Vec<f32> = weights
+            .iter()
+            .map(|w| {
+                running += w;
+                (running / total) as f32
+            })
+            .collect();
+        *cdf.last_mut()? = 1.0;
+        Some(Discrete { cdf })
+    }
+
+    /// The index `u` in [0, 1) draws, and `u` stretched to [0, 1] over
+    /// that index's share (a second uniform number for free).
+    pub fn sample(&self, u: f32) -> (usize, f32) {
+        let i = self.cdf.partition_point(|&c| c <= u).min(self.cdf.len() - 1);
+        let (lo, width) = (self.below(i), self.prob(i));
+        let rest = if width > 0.0 { ((u - lo) / width).clamp(0.0, 1.0) } else { 0.5 };
+        (i, rest)
+    }
+
+    /// The probability that [`Self::sample`] draws `i`: a share below
+    /// f32's resolution is never drawn, and has probability zero.
+    pub fn prob(&self, i: usize) -> f32 {
+        self.cdf[i] - self.below(i)
+    }
+
+    fn below(&self, i: usize) -> f32 {
+        if i == 0 {
+            0.0
+        } else {
+            self.cdf[i - 1]
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -299,5 +353,26 @@ mod tests {
                 assert!(hi.x - lo.x <= 1.0 / (n as f32).sqrt().floor() + 1e-5);
             }
         }
+    }
+
+    /// Draws follow the weights, zero weights are never drawn, and the
+    /// stretched number is uniform within a share.
+    #[test]
+    fn a_discrete_distribution_draws_in_proportion_to_its_weights() {
+        let d = Discrete::new([1.0, 0.0, 3.0, -2.0, f64::NAN, 4.0]).unwrap();
+        assert_eq!((d.prob(1), d.prob(3), d.prob(4)), (0.0, 0.0, 0.0));
+        assert!((d.prob(0) - 0.125).abs() < 1e-6 && (d.prob(5) - 0.5).abs() < 1e-6);
+        let n = 80_000;
+        let (mut counts, mut rest) = ([0u32; 6], 0.0f64);
+        for k in 0..n {
+            let (i, r) = d.sample((k as f32 + 0.5) / n as f32);
+            counts[i] += 1;
+            rest += r as f64;
+        }
+        for i in 0..6 {
+            assert!((counts[i] as f32 / n as f32 - d.prob(i)).abs() < 1e-3, "{i}: {counts:?}");
+        }
+        assert!((rest / n as f64 - 0.5).abs() < 1e-3);
+        assert!(Discrete::new([0.0, -1.0]).is_none() && Discrete::new([]).is_none());
     }
 }

@@ -2,10 +2,11 @@
 
 use super::Context;
 use crate::light::{Incident, Light};
-use crate::math::Color;
+use crate::math::{Color, Ray};
 use crate::sampling::{next_2d, stratified_2d};
 use crate::scene::{Hit, Scene};
 use glam::Vec3;
+use std::f32::consts::{FRAC_1_PI, PI};
 
 /// Light reflected at a surface point straight from the lights:
 /// sum over lights of f(w) I cos_x, averaged over `count` stratified samples
@@ -59,14 +60,14 @@ pub fn direct_light(
 /// by a short ray down onto it (zero where there is none).
 pub fn direct_irradiance(scene: &Scene, x: Vec3, n: Vec3, count: u32, skip: bool, ctx: &mut Context) -> Color {
     let height = 1e-4 * (1.0 + x.abs().max_element());
-    let Some(hit) = scene.intersect(&crate::math::Ray::new(x + height * n, -n), None) else {
+    let Some(hit) = scene.intersect(&Ray::new(x + height * n, -n), None) else {
         return Color::ZERO;
     };
     if hit.t > 2.0 * height {
         return Color::ZERO;
     }
-    let brdf = |_: Vec3| Color::splat(std::f32::consts::FRAC_1_PI);
-    std::f32::consts::PI * direct_light(scene, &hit, n, brdf, count, skip, ctx)
+    let brdf = |_: Vec3| Color::splat(FRAC_1_PI);
+    PI * direct_light(scene, &hit, n, brdf, count, skip, ctx)
 }
 
 /// [`direct_light`] one sample at a time: the reference it must equal.

@@ -8,6 +8,7 @@
 //! (`integrator::aim`), weighed so that no light is counted twice.
 
 use crate::math::Frame;
+use crate::sampling::Discrete;
 use glam::{IVec3, Vec2, Vec3};
 use std::collections::HashMap;
 
@@ -177,7 +178,7 @@ pub fn bright_spots(
 impl Spot {
     /// Whether the spot is flat: its cap at most [`SHALLOW_SPOT`] of its
     /// radius deep.
-    pub fn is_flat(&self) -> bool {
+    fn is_flat(&self) -> bool {
         self.behind <= SHALLOW_SPOT * self.radius && self.normal != Vec3::ZERO
     }
 
@@ -201,87 +202,78 @@ impl Spot {
 /// the dim floor around them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PatchMap {
+    square: Square,
+    /// The cells, row by row, by their weights.
+    cells: Discrete,
+}
+
+/// The square of a [`PatchMap`], with coordinates in cells from a corner.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Square {
     center: Vec3,
     frame: Frame,
     half: f32,
-    /// The cells' cumulative shares, row by row; the last is 1.
-    cdf: Vec<f32>,
-    /// Each cell's density per unit area of the plane.
-    density: Vec<f32>,
+}
+
+impl Square {
+    fn cell(&self) -> f32 {
+        2.0 * self.half / PATCH_CELLS as f32
+    }
+
+    /// The point of the plane at (`x`, `y`) cells from the corner.
+    fn point(&self, x: f32, y: f32) -> Vec3 {
+        let (x, y) = (x * self.cell() - self.half, y * self.cell() - self.half);
+        self.center + self.frame.s * x + self.frame.t * y
+    }
+
+    /// The cell holding `p`, a point of the plane, if the square does.
+    fn cell_of(&self, p: Vec3) -> Option<usize> {
+        let d = p - self.center;
+        let (x, y) = ((d.dot(self.frame.s) + self.half) / self.cell(), (d.dot(self.frame.t) + self.half) / self.cell());
+        if !(x >= 0.0 && y >= 0.0 && x < PATCH_CELLS as f32 && y < PATCH_CELLS as f32) {
+            return None;
+        }
+        Some((y as usize).min(PATCH_CELLS - 1) * PATCH_CELLS + (x as usize).min(PATCH_CELLS - 1))
+    }
 }
 
 impl PatchMap {
     /// Each cell weighed by the mean of `irradiance` at four points in it;
     /// None where no cell has any (or the square is degenerate).
     pub fn build(center: Vec3, normal: Vec3, radius: f32, irradiance: impl Fn(Vec3) -> f32) -> Option<Self> {
-        let frame = Frame::from_normal(normal);
-        let cell = 2.0 * radius / PATCH_CELLS as f32;
-        if !(cell > 0.0) || !cell.is_finite() || !center.is_finite() {
+        if !(radius > 0.0) || !radius.is_finite() || !center.is_finite() {
             return None;
         }
-        let point = |ix: usize, iy: usize, fx: f32, fy: f32| {
-            let (x, y) = ((ix as f32 + fx) * cell - radius, (iy as f32 + fy) * cell - radius);
-            center + frame.s * x + frame.t * y
-        };
-        let weights: Vec<f64> = (0..PATCH_CELLS * PATCH_CELLS)
-            .map(|i| {
-                let (ix, iy) = (i % PATCH_CELLS, i / PATCH_CELLS);
-                [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)]
-                    .iter()
-                    .map(|&(fx, fy)| irradiance(point(ix, iy, fx, fy)) as f64)
-                    .filter(|e| e.is_finite() && *e > 0.0)
-                    .sum::<f64>()
-            })
-            .collect();
-        let total: f64 = weights.iter().sum();
-        if !(total > 0.0) || !total.is_finite() {
-            return None;
-        }
-        let mut running = 0.0;
-        let mut cdf: Vec<f32> = weights
-            .iter()
-            .map(|w| {
-                running += w;
-                (running / total) as f32
-            })
-            .collect();
-        *cdf.last_mut()? = 1.0;
-        // Each cell's share as the sampling sees it (a share below f32's
-        // resolution is never drawn, and has density zero).
-        let area = cell * cell;
-        let density = (0..cdf.len()).map(|i| (cdf[i] - if i == 0 { 0.0 } else { cdf[i - 1] }) / area).collect();
-        Some(PatchMap { center, frame, half: radius, cdf, density })
+        let square = Square { center, frame: Frame::from_normal(normal), half: radius };
+        let weights = (0..PATCH_CELLS * PATCH_CELLS).map(|i| {
+            let (ix, iy) = ((i % PATCH_CELLS) as f32, (i / PATCH_CELLS) as f32);
+            [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)]
+                .iter()
+                .map(|&(fx, fy)| irradiance(square.point(ix + fx, iy + fy)) as f64)
+                .filter(|e| e.is_finite() && *e > 0.0)
+                .sum::<f64>()
+        });
+        Some(PatchMap { square, cells: Discrete::new(weights)? })
     }
 
     pub fn center(&self) -> Vec3 {
-        self.center
+        self.square.center
     }
 
     pub fn normal(&self) -> Vec3 {
-        self.frame.n
+        self.square.frame.n
     }
 
     /// A point of the plane drawn from the density (`u` uniform in [0, 1)^2).
     pub fn sample(&self, u: Vec2) -> Vec3 {
-        let i = self.cdf.partition_point(|&c| c <= u.x).min(self.cdf.len() - 1);
-        let lo = if i == 0 { 0.0 } else { self.cdf[i - 1] };
-        let fx = ((u.x - lo) / (self.cdf[i] - lo)).clamp(0.0, 1.0);
-        let cell = 2.0 * self.half / PATCH_CELLS as f32;
-        let (ix, iy) = (i % PATCH_CELLS, i / PATCH_CELLS);
-        let (x, y) = ((ix as f32 + fx) * cell - self.half, (iy as f32 + u.y) * cell - self.half);
-        self.center + self.frame.s * x + self.frame.t * y
+        let (i, fx) = self.cells.sample(u.x);
+        self.square.point((i % PATCH_CELLS) as f32 + fx, (i / PATCH_CELLS) as f32 + u.y)
     }
 
     /// The density per unit area at `p`, a point of the plane.
     pub fn area_pdf(&self, p: Vec3) -> f32 {
-        let d = p - self.center;
-        let cell = 2.0 * self.half / PATCH_CELLS as f32;
-        let (x, y) = ((d.dot(self.frame.s) + self.half) / cell, (d.dot(self.frame.t) + self.half) / cell);
-        if !(x >= 0.0 && y >= 0.0 && x < PATCH_CELLS as f32 && y < PATCH_CELLS as f32) {
-            return 0.0;
-        }
-        let (ix, iy) = ((x as usize).min(PATCH_CELLS - 1), (y as usize).min(PATCH_CELLS - 1));
-        self.density[iy * PATCH_CELLS + ix]
+        let cell = self.square.cell();
+        self.square.cell_of(p).map_or(0.0, |i| self.cells.prob(i) / (cell * cell))
     }
 }
 

@@ -3,14 +3,16 @@
 //! camera pass's estimator over them.
 
 use crate::integrator::photon::{PhotonEstimator, PhotonIntegrator};
+use crate::integrator::{direct_irradiance, Context};
 use crate::photon::irradiance_cache::IrradianceCache;
 use crate::photon::map::PhotonMap;
 use crate::photon::spots::{bright_spots, Spot};
 use crate::photon::trace::{trace_pass, Pass};
 use crate::progress::{Mode, Phase};
+use crate::sampling::{stream, Domain};
 use crate::scene::Scene;
 use crate::settings::{cache_stride, Settings};
-use crate::stats::Stats;
+use crate::stats::{Counters, Stats};
 use std::time::Instant;
 
 /// The density-estimation settings of one photon-mapping pass: k nearest
@@ -124,10 +126,10 @@ pub fn photon_pass(
     // The global map holds no photon's first hit: the cache adds the
     // direct light by shadow rays.
     let direct = |i: u64, x, n| {
-        let mut rng = crate::sampling::stream(seed, crate::sampling::Domain::CacheDirect, i);
-        let mut counters = crate::stats::Counters::default();
-        let mut ctx = crate::integrator::Context { rng: &mut rng, counters: &mut counters, pixel: i };
-        crate::integrator::direct_irradiance(scene, x, n, CACHE_SHADOW_RAYS, settings.skip, &mut ctx)
+        let mut rng = stream(seed, Domain::CacheDirect, i);
+        let mut counters = Counters::default();
+        let mut ctx = Context { rng: &mut rng, counters: &mut counters, pixel: i };
+        direct_irradiance(scene, x, n, CACHE_SHADOW_RAYS, settings.skip, &mut ctx)
     };
     let cache = IrradianceCache::build_with(&global_map, stride, est.k_global, est.r_global, &coverage, Some(&direct));
     let spots = if settings.aimed_rays() > 0 {

@@ -8,6 +8,7 @@ use crate::camera::Camera;
 use crate::light::{directional_reach, AreaLight, Emitting, Light};
 use crate::material::Material;
 use crate::math::{max_component, offset_ray_origin, Color, Frame, Ray, Vertex};
+use crate::sampling::Discrete;
 pub mod file;
 pub mod mesh;
 pub mod procedural;
@@ -162,8 +163,8 @@ pub struct Scene {
     accel: Accel,
     bounds: (Vec3, Vec3),
     targets: Vec<Target>,
-    /// Running sum of the lights' powers (largest channel), for choosing one.
-    light_cdf: Vec<f32>,
+    /// The lights by power (largest channel): the photon passes' choice.
+    light_pick: Option<Discrete>,
 }
 
 /// Marks a primitive that is not a light's surface.
@@ -325,13 +326,7 @@ impl Scene {
             prims.iter().zip(&prim_light).map(|(p, &l)| (l == NO_LIGHT).then_some(p.material)).collect();
         let prim_material = prims.iter().map(|p| p.material).collect();
         let accel = Accel::with_enclosure(prims.into_iter().map(|p| p.shape).collect(), &group);
-        let light_cdf = lights
-            .iter()
-            .scan(0.0f32, |acc, l| {
-                *acc += max_component(l.power());
-                Some(*acc)
-            })
-            .collect();
+        let light_pick = Discrete::new(lights.iter().map(|l| max_component(l.power()) as f64));
         Scene {
             materials,
             lights,
@@ -343,7 +338,7 @@ impl Scene {
             accel,
             bounds: (lo, hi),
             targets,
-            light_cdf,
+            light_pick,
         }
     }
 
@@ -493,14 +488,9 @@ impl Scene {
     /// emits anything.
     #[inline]
     pub fn pick_light(&self, u: f32) -> Option<(&Light, f32)> {
-        let total = *self.light_cdf.last()?;
-        if !(total > 0.0) {
-            return None;
-        }
-        let x = u * total;
-        let i = self.light_cdf.partition_point(|&c| c <= x).min(self.lights.len() - 1);
-        let below = if i == 0 { 0.0 } else { self.light_cdf[i - 1] };
-        let p = (self.light_cdf[i] - below) / total;
+        let lights = self.light_pick.as_ref()?;
+        let i = lights.sample(u).0;
+        let p = lights.prob(i);
         (p > 0.0).then(|| (&self.lights[i], p))
     }
 
