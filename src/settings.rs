@@ -21,7 +21,7 @@ pub struct Settings {
     pub photons: u64,
     /// Photons emitted (aimed at mirrors and glass) for the caustic map.
     pub caustic_photons: u64,
-    /// Jittered camera samples per pixel.
+    /// Camera samples per pixel.
     pub spp: u32,
     pub seed: u64,
     pub width: u32,

@@ -17,7 +17,7 @@ use crate::material::{Material, Phong, Transport};
 use crate::math::{max_component, Color, Frame, Ray};
 use crate::optics::reflect;
 use crate::progress::Mode;
-use crate::render::{camera_pass, CameraPass};
+use crate::render::{camera_pass, CameraPass, Placement};
 use crate::sampling::{next_2d, stratified_2d, Rng};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;
@@ -122,8 +122,14 @@ impl Whitted<'_> {
     /// camera pass, each pixel the mean of `spp` jittered samples
     /// (stratified when `spp` is a square: the course's n x n grid).
     pub fn render(&self, width: u32, height: u32, spp: u32, seed: u64, progress: Mode) -> Film {
-        let pass =
-            CameraPass { camera: self.scene.camera.with_resolution(width, height), spp, edge_spp: 0, seed, pass: 0 };
+        let pass = CameraPass {
+            camera: self.scene.camera.with_resolution(width, height),
+            spp,
+            edge_spp: 0,
+            seed,
+            pass: 0,
+            placement: Placement::JitteredGrid,
+        };
         camera_pass(&pass, self, progress, &mut None).film
     }
 }

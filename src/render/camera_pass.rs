@@ -1,7 +1,7 @@
 //! The camera pass: every pixel of the film estimated by an integrator,
-//! rows in parallel. Each pixel averages `spp` jittered samples (a box
-//! filter); pixels on the rim of a light's image estimate the emitted part
-//! with `edge_spp` samples of their own. Each pixel has its own random
+//! rows in parallel. Each pixel averages `spp` samples (a box filter),
+//! placed by a [`Placement`]; pixels on the rim of a light's image
+//! estimate the emitted part with `edge_spp` samples of their own. Each pixel has its own random
 //! stream per pass, so rows can run on any thread in any order.
 
 use super::rims::light_rims;
@@ -9,7 +9,7 @@ use crate::camera::Camera;
 use crate::film::Film;
 use crate::integrator::{Context, Integrator, Part};
 use crate::progress::{Mode, Phase};
-use crate::sampling::{next_2d, stratified_2d, stream, Domain};
+use crate::sampling::{next_2d, sobol_owen_2d, splitmix64, stratified_2d, stream, Domain};
 use crate::stats::Counters;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -25,6 +25,21 @@ pub struct CameraPass {
     pub edge_spp: u32,
     pub seed: u64,
     pub pass: u64,
+    pub placement: Placement,
+}
+
+/// Where a pixel's samples fall.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Placement {
+    /// The CS475 course's n x n grid over the pixel, jittered (a line of
+    /// jittered strata where the count is not a square), drawn anew each
+    /// pass.
+    JitteredGrid,
+    /// A scrambled Sobol sequence that continues from pass to pass: the
+    /// samples of all passes so far stay stratified (a sunlit patch's
+    /// sharp border at 48 passes of 1 sample: the sun window's RMSE less
+    /// the reference's noise -13%, notes/performance.md).
+    Sobol,
 }
 
 /// A camera pass's film and what it counted.
@@ -38,6 +53,13 @@ pub struct Shot {
 /// The random-stream index of a pixel in a pass: passes get disjoint streams.
 pub(crate) fn sample_index(pass: u64, pixel: u64) -> u64 {
     (pass << 40) | pixel
+}
+
+/// The scramble of a pixel's sample positions: its own for each pixel and
+/// each part, the same in every pass, so that the passes continue one
+/// stratified sequence.
+fn pixel_scramble(seed: u64, pixel: u64, part: Part) -> u64 {
+    splitmix64(splitmix64(seed ^ splitmix64(Domain::Camera as u64)) ^ splitmix64(pixel) ^ part as u64)
 }
 
 /// Renders the film. The rim pixels are found once, by the probes of the
@@ -84,9 +106,15 @@ pub fn camera_pass<I: Integrator>(
                 let mut state = I::Pixel::default();
                 let mut estimate = |part: Part, n: u32| {
                     let mut ctx = Context { rng: &mut rng, counters: &mut counters, pixel };
+                    let scramble = pixel_scramble(pass.seed, pixel, part);
+                    let first = pass.pass.wrapping_mul(n as u64);
                     let mut sum = DVec3::ZERO;
                     for s in 0..n {
-                        let ray = camera.ray(col, row, stratified_2d(s, n, next_2d(ctx.rng)));
+                        let u = match pass.placement {
+                            Placement::JitteredGrid => stratified_2d(s, n, next_2d(ctx.rng)),
+                            Placement::Sobol => sobol_owen_2d(first.wrapping_add(s as u64) as u32, scramble),
+                        };
+                        let ray = camera.ray(col, row, u);
                         sum += integrator.radiance(ray, part, &mut ctx, thread, &mut state).as_dvec3();
                     }
                     sum += integrator.finish(&mut ctx, thread, &mut state).as_dvec3();

@@ -9,7 +9,7 @@ pub mod photon_stage;
 pub mod progressive;
 mod rims;
 
-pub use camera_pass::{camera_pass, CameraPass};
+pub use camera_pass::{camera_pass, CameraPass, Placement};
 pub use photon_stage::GLOBAL_GRID_CELL;
 pub use progressive::{render_passes, render_progressive, Budget, PassReport, Run, Stopped};
 
@@ -46,6 +46,7 @@ pub(crate) fn render_pass(
         edge_spp: settings.edge_spp,
         seed: settings.seed,
         pass: pass as u64,
+        placement: Placement::Sobol,
     };
     let t = Instant::now();
     let shot = match settings.method {

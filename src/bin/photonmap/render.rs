@@ -113,7 +113,8 @@ pub struct RenderArgs {
     /// Photons emitted towards mirrors and glass [default: as --photons].
     #[arg(long, value_parser = parse_count)]
     caustic_photons: Option<u64>,
-    /// Jittered camera samples per pixel (stratified when a square)
+    /// Camera samples per pixel (a scrambled Sobol sequence, continued
+    /// from pass to pass)
     /// [default: 4, or rays_per_pixel_edge squared from a scene file; 1 for
     /// progressive renders].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
