@@ -230,3 +230,27 @@ fn help_documents_every_option_with_its_default() {
     }
     assert!(help.contains("[default: 1e6; 2.5e5 for progressive renders]"));
 }
+
+/// `export --origin` takes negative coordinates as a value (the suite's
+/// Cornell box places Mitsuba's origin at x = -0.4), and the written eye
+/// is the scene's eye less the origin, times the scale.
+#[test]
+fn export_takes_a_negative_origin() {
+    let dir = scratch_dir("cli-export-origin");
+    let xml = dir.join("cornell.xml");
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/suite/02-cornell.toml");
+    let o = photonmap(&[
+        "export",
+        "--mitsuba",
+        scene.to_str().unwrap(),
+        xml.to_str().unwrap(),
+        "--origin",
+        "-0.4,0.05,0.35",
+        "--scale",
+        "100",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&xml).unwrap();
+    // The eye (0, -3.4, 1) less (-0.4, 0.05, 0.35), times 100.
+    assert!(text.contains("lookat origin=\"40, -345, 65\""), "{text}");
+}

@@ -28,8 +28,9 @@ pub struct Args {
     /// The point of the scene written as Mitsuba's origin [default: the
     /// camera's eye]. Mitsuba offsets a ray leaving a surface by a length
     /// that grows with the distance from its origin: for a reference that
-    /// resolves a small glass object, give its centre here.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_point)]
+    /// resolves a small glass object or a sharp shadow, give its centre
+    /// here.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_point, allow_hyphen_values = true)]
     origin: Option<glam::Vec3>,
     /// Mitsuba's units per scene unit (the image is the same); with
     /// --origin, a large scale makes the ray offsets a fixed fraction of
