@@ -17,7 +17,7 @@
 //! the notes go; default notes/).
 
 use photonmap::film::{Film, ToneMap};
-use photonmap::metrics::{box_down, compare_images, diff_rgb8, Comparison};
+use photonmap::metrics::{box_down, compare_images, compare_window, diff_rgb8, Comparison};
 use photonmap::output::{read_exr, write, write_rgb8_image};
 use photonmap::progress::Mode;
 use photonmap::render::{render, render_progressive, Budget};
@@ -67,10 +67,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut rows = Vec::new();
     for s in suite.iter().filter(|s| only.is_empty() || only.contains(&s.name)) {
         let reference = s.load_reference()?;
+        let caustic_reference = s.load_caustic_reference()?;
         let info = s.reference_info();
         let noise = (info.noise, info.caustic_noise);
         let score = |film: &Film, seconds: f64, count: u64| -> Result<Scored, String> {
-            let c = compare_images(film, &reference, std::slice::from_ref(&s.caustic)).map_err(|e| e.to_string())?;
+            let mut c =
+                compare_images(film, &reference, std::slice::from_ref(&s.caustic)).map_err(|e| e.to_string())?;
+            if let Some(crop) = &caustic_reference {
+                c.windows[0].1 = compare_window(film, c.factor, &s.caustic, crop).map_err(|e| e.to_string())?;
+            }
             let (rmse, caustic_rmse) = (less_noise(c.whole.rmse, noise.0), less_noise(c.windows[0].1.rmse, noise.1));
             Ok(Scored { seconds, count, c, rmse, caustic_rmse })
         };
@@ -290,6 +295,26 @@ fn report(rows: &[Row], suite: &[SuiteScene], seconds: f64) -> String {
         }
     }
     let _ = writeln!(s, "\n{}", below_noise(rows, seconds));
+    let cropped: Vec<String> = suite
+        .iter()
+        .filter(|x| x.caustic_reference.is_some() && rows.iter().any(|r| r.name == x.name))
+        .map(|x| {
+            let json = x.caustic_reference.as_ref().map(|p| p.with_extension("json"));
+            let spp = json
+                .and_then(|j| std::fs::read_to_string(j).ok())
+                .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+                .and_then(|v| v["spp"].as_u64());
+            format!("{} ({} spp)", x.name, spp.map_or("—".into(), |v| v.to_string()))
+        })
+        .collect();
+    if !cropped.is_empty() {
+        let _ = writeln!(
+            s,
+            "The caustic window of {} is scored against a reference of that window alone, rendered with more \
+             samples (suite.toml's `caustic_reference`); its caustic noise is that reference's.\n",
+            cropped.join(", ")
+        );
+    }
     let _ = writeln!(s, "## The scenes\n\nEach picture: photonmap's default render (reduced to 200 x 200) | the reference | the signed difference (red: photonmap brighter, blue: darker).\n");
     for r in rows {
         let comment = suite

@@ -252,6 +252,37 @@ pub fn compare_images(test: &Film, reference: &Film, windows: &[Window]) -> Resu
     })
 }
 
+/// The `window` of `test`, reduced by `factor`, scored against a reference
+/// of that window alone (`crop`, its size): where a whole-image reference
+/// would be too noisy to measure a small window's error, a crop rendered
+/// with many more samples costs a fraction of it.
+pub fn compare_window(test: &Film, factor: u32, window: &Window, crop: &Film) -> Result<Region, Mismatch> {
+    let (h, w) = (window.rows.1 - window.rows.0, window.cols.1 - window.cols.0);
+    if (crop.width, crop.height) != (w, h) {
+        return Err(Mismatch::Size(w, h, crop.width, crop.height));
+    }
+    if window.rows.1 * factor > test.height || window.cols.1 * factor > test.width {
+        return Err(Mismatch::Window {
+            name: window.name.clone(),
+            r0: window.rows.0,
+            r1: window.rows.1,
+            c0: window.cols.0,
+            c1: window.cols.1,
+            w: test.width / factor.max(1),
+            h: test.height / factor.max(1),
+        });
+    }
+    let (clean, _) = finite(test);
+    let reduced = box_down(&clean, factor);
+    let mut sums = Sums::default();
+    for row in 0..h {
+        for col in 0..w {
+            sums.add(reduced.get(window.cols.0 + col, window.rows.0 + row).as_dvec3(), crop.get(col, row).as_dvec3());
+        }
+    }
+    Ok(sums.region())
+}
+
 /// Brightness of a pixel for the speckle count: the mean of its channels.
 fn brightness(c: Color) -> f32 {
     (c.x + c.y + c.z) / 3.0
@@ -421,6 +452,27 @@ mod tests {
 
     fn film(w: u32, h: u32, f: impl Fn(u32, u32) -> Color) -> Film {
         Film { width: w, height: h, pixels: (0..w * h).map(|i| f(i % w, i / w)).collect() }
+    }
+
+    /// A window scored against a crop of the reference scores as the same
+    /// window of the whole reference, the test reduced alike; a crop of
+    /// another size is refused.
+    #[test]
+    fn a_window_against_its_crop_scores_as_against_the_whole_reference() {
+        let reference = film(10, 8, |x, y| Color::new(0.1 * x as f32, 0.05 * y as f32, 0.3));
+        let test = film(20, 16, |x, y| Color::new(0.06 * x as f32, 0.02 * (x + y) as f32, 0.25 + 0.01 * y as f32));
+        let w = Window::parse("spot=2:7,3:9", 0).unwrap();
+        let whole = compare_images(&test, &reference, std::slice::from_ref(&w)).unwrap();
+        let crop = film(6, 5, |x, y| reference.get(x + 3, y + 2));
+        let alone = compare_window(&test, whole.factor, &w, &crop).unwrap();
+        let full = whole.windows[0].1;
+        assert_eq!(alone.pixels, full.pixels);
+        assert!((alone.rmse - full.rmse).abs() < 1e-12 && (alone.relmse - full.relmse).abs() < 1e-12);
+        assert!((alone.mean_test - full.mean_test).abs() < 1e-12 && (alone.mean_ref - full.mean_ref).abs() < 1e-12);
+        assert!(compare_window(&test, whole.factor, &w, &film(5, 6, |_, _| Color::ZERO)).is_err());
+        assert!(
+            compare_window(&test, 2, &Window::parse("2:9,3:9", 0).unwrap(), &film(6, 7, |_, _| Color::ZERO)).is_err()
+        );
     }
 
     /// A known difference gives the known numbers: a test 0.1 brighter than

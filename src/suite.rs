@@ -22,6 +22,8 @@ struct EntryDef {
     reference: String,
     caustic: WindowDef,
     #[serde(default)]
+    caustic_reference: Option<String>,
+    #[serde(default)]
     mitsuba: Option<PlacementDef>,
 }
 
@@ -48,6 +50,10 @@ pub struct SuiteScene {
     pub reference: PathBuf,
     /// The caustic window, in the reference's pixels.
     pub caustic: Window,
+    /// A reference of the caustic window alone, with more samples, where
+    /// the whole image's is too noisy to measure the window's error: it
+    /// scores the window in its place.
+    pub caustic_reference: Option<PathBuf>,
     /// Where the reference's Mitsuba scene puts its origin, and its scale
     /// (`photonmap export --origin --scale`), where not at the eye: Mitsuba's
     /// equal-time renders use the same.
@@ -66,22 +72,26 @@ pub struct ReferenceInfo {
 
 impl SuiteScene {
     pub fn load_reference(&self) -> Result<Film, String> {
-        read_exr(&self.reference).map_err(|e| e.to_string())
+        read_exr(&self.reference).map_err(|e| format!("{}: {e}", self.reference.display()))
+    }
+
+    /// The caustic window's own reference, if the scene has one.
+    pub fn load_caustic_reference(&self) -> Result<Option<Film>, String> {
+        self.caustic_reference.as_ref().map(|p| read_exr(p).map_err(|e| format!("{}: {e}", p.display()))).transpose()
     }
 
     pub fn reference_info(&self) -> ReferenceInfo {
-        let json = self.reference.with_extension("json");
-        let Ok(text) = std::fs::read_to_string(&json) else {
+        let json = |path: &Path| -> Option<serde_json::Value> {
+            serde_json::from_str(&std::fs::read_to_string(path.with_extension("json")).ok()?).ok()
+        };
+        let Some(v) = json(&self.reference) else {
             return ReferenceInfo::default();
         };
-        let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else {
-            return ReferenceInfo::default();
+        let caustic_noise = match &self.caustic_reference {
+            Some(crop) => json(crop).and_then(|c| c["noise_rmse"].as_f64()),
+            None => v["windows"]["caustic"]["noise_rmse"].as_f64(),
         };
-        ReferenceInfo {
-            spp: v["spp"].as_u64(),
-            noise: v["noise_rmse"].as_f64(),
-            caustic_noise: v["windows"]["caustic"]["noise_rmse"].as_f64(),
-        }
+        ReferenceInfo { spp: v["spp"].as_u64(), noise: v["noise_rmse"].as_f64(), caustic_noise }
     }
 }
 
@@ -101,6 +111,7 @@ pub fn load(dir: &Path) -> Result<Vec<SuiteScene>, String> {
                 rows: (e.caustic.rows[0], e.caustic.rows[1]),
                 cols: (e.caustic.cols[0], e.caustic.cols[1]),
             },
+            caustic_reference: e.caustic_reference.map(|r| dir.join(r)),
             mitsuba_placement: e.mitsuba.map(|p| (glam::Vec3::from(p.origin), p.scale)),
         })
         .collect())

@@ -98,3 +98,20 @@ fn suite_07_million() {
 fn suite_08_hall() {
     check("08-hall");
 }
+
+/// Every reference the manifest names loads, with its noise, and a
+/// caustic window's own reference has the window's size.
+#[test]
+fn the_manifest_references_load_and_fit_their_windows() {
+    let suite = photonmap::suite::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/suite")).unwrap();
+    assert_eq!(suite.len(), 8);
+    for s in &suite {
+        let reference = s.load_reference().unwrap();
+        assert!(s.caustic.rows.1 <= reference.height && s.caustic.cols.1 <= reference.width, "{}", s.name);
+        if let Some(crop) = s.load_caustic_reference().unwrap() {
+            let w = &s.caustic;
+            assert_eq!((crop.width, crop.height), (w.cols.1 - w.cols.0, w.rows.1 - w.rows.0), "{}", s.name);
+            assert!(s.reference_info().caustic_noise.is_some(), "{}: the crop's noise", s.name);
+        }
+    }
+}

@@ -4,6 +4,7 @@ the scene as `photonmap export --mitsuba` writes it.
 
 usage: mitsuba_reference.py SCENE.xml OUT.exr --width W --height H --spp N
                             [--passes P] [--window NAME=R0:R1,C0:C1 ...]
+                            [--crop R0:R1,C0:C1]
                             [--variant llvm_ad_rgb] [--seed S] [--keep-halves DIR]
 
 Renders P passes of N/P samples per pixel (independent seeds), averages them
@@ -12,7 +13,10 @@ splitting the passes into two halves A and B: the RMSE of the full average
 is RMSE(A - B) / 2 (each half has twice the variance of the whole). Writes
 OUT.json beside it: spp, passes, seconds, the Mitsuba version, and that noise
 for the whole image and for each window (rows and columns of OUT.exr,
-half-open). Not a dependency of the project and not run in CI: its outputs
+half-open). With --crop, only that rectangle of the W x H image is
+rendered (many samples for a window at a fraction of the whole image's
+cost): OUT.exr holds the rectangle, and OUT.json says where it lies
+("crop": rows and columns). Not a dependency of the project and not run in CI: its outputs
 are committed under tests/data/.
 
 Setup: python3 -m venv V && V/bin/pip install mitsuba==3.9.1 numpy openexr.
@@ -47,6 +51,7 @@ def main():
     ap.add_argument("--width", type=int, required=True); ap.add_argument("--height", type=int, required=True)
     ap.add_argument("--spp", type=int, required=True); ap.add_argument("--passes", type=int, default=16)
     ap.add_argument("--window", action="append", default=[])
+    ap.add_argument("--crop", help="render only rows R0:R1, columns C0:C1 of the image")
     ap.add_argument("--variant", default="llvm_ad_rgb"); ap.add_argument("--seed", type=int, default=1000)
     ap.add_argument("--keep-halves", metavar="DIR", help="also write the two halves' averages there")
     a = ap.parse_args()
@@ -54,8 +59,26 @@ def main():
     mi.set_variant(a.variant)
     passes = max(2, a.passes - a.passes % 2)
     per = max(1, a.spp // passes)
-    scene = mi.load_file(a.scene, spp=per, width=a.width, height=a.height)
-    halves = [np.zeros((a.height, a.width, 3)), np.zeros((a.height, a.width, 3))]
+    if a.crop:
+        import os
+        _, (r0, r1, c0, c1) = parse_window(a.crop)
+        if not (0 <= r0 < r1 <= a.height and 0 <= c0 < c1 <= a.width):
+            sys.exit(f"--crop {a.crop}: not inside the {a.width} x {a.height} image")
+        with open(a.scene) as f:
+            xml = f.read()
+        film = '<film type="hdrfilm">'
+        if xml.count(film) != 1:
+            sys.exit(f"{a.scene}: no single '{film}' to crop")
+        xml = xml.replace(film, film + "".join(
+            f'<integer name="{k}" value="{v}"/>'
+            for k, v in [("crop_offset_x", c0), ("crop_offset_y", r0), ("crop_width", c1 - c0), ("crop_height", r1 - r0)]))
+        mi.Thread.thread().file_resolver().prepend(os.path.dirname(os.path.abspath(a.scene)))
+        scene = mi.load_string(xml, spp=per, width=a.width, height=a.height)
+        shape = (r1 - r0, c1 - c0, 3)
+    else:
+        scene = mi.load_file(a.scene, spp=per, width=a.width, height=a.height)
+        shape = (a.height, a.width, 3)
+    halves = [np.zeros(shape), np.zeros(shape)]
     t0 = time.time()
     for p in range(passes):
         img = np.array(mi.render(scene, spp=per, seed=a.seed + p), dtype=np.float64)[..., :3]
@@ -82,6 +105,8 @@ def main():
         "noise_rmse": noise(), "mean": float(mean.mean()), "nonfinite": bad,
         "windows": {},
     }
+    if a.crop:
+        info["crop"] = {"rows": [r0, r1], "cols": [c0, c1]}
     for w in a.window:
         name, (r0, r1, c0, c1) = parse_window(w)
         info["windows"][name] = {"rows": [r0, r1], "cols": [c0, c1], "noise_rmse": noise(r0, r1, c0, c1),
