@@ -310,8 +310,8 @@ fn report(rows: &[Row], suite: &[SuiteScene], seconds: f64) -> String {
     if !cropped.is_empty() {
         let _ = writeln!(
             s,
-            "The caustic window of {} is scored against a reference of that window alone, rendered with more \
-             samples (suite.toml's `caustic_reference`); its caustic noise is that reference's.\n",
+            "Caustic windows scored against a reference of the window alone, rendered with more samples \
+             (suite.toml's `caustic_reference`), whose noise is the caustic noise above: {}.\n",
             cropped.join(", ")
         );
     }

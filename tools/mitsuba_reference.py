@@ -72,7 +72,7 @@ def main():
         xml = xml.replace(film, film + "".join(
             f'<integer name="{k}" value="{v}"/>'
             for k, v in [("crop_offset_x", c0), ("crop_offset_y", r0), ("crop_width", c1 - c0), ("crop_height", r1 - r0)]))
-        mi.Thread.thread().file_resolver().prepend(os.path.dirname(os.path.abspath(a.scene)))
+        mi.file_resolver().prepend(os.path.dirname(os.path.abspath(a.scene)))
         scene = mi.load_string(xml, spp=per, width=a.width, height=a.height)
         shape = (r1 - r0, c1 - c0, 3)
     else:
