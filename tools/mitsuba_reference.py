@@ -6,6 +6,7 @@ usage: mitsuba_reference.py SCENE.xml OUT.exr --width W --height H --spp N
                             [--passes P] [--window NAME=R0:R1,C0:C1 ...]
                             [--crop R0:R1,C0:C1]
                             [--variant llvm_ad_rgb] [--seed S] [--keep-halves DIR]
+                            [--add STEM --add-spp M]
 
 Renders P passes of N/P samples per pixel (independent seeds), averages them
 in float64 and writes OUT.exr (float32 RGB). Its own noise is estimated by
@@ -16,7 +17,11 @@ for the whole image and for each window (rows and columns of OUT.exr,
 half-open). With --crop, only that rectangle of the W x H image is
 rendered (many samples for a window at a fraction of the whole image's
 cost): OUT.exr holds the rectangle, and OUT.json says where it lies
-("crop": rows and columns). Not a dependency of the project and not run in CI: its outputs
+("crop": rows and columns). With --add, the halves of an earlier render
+of the same scene (STEM.half-a.exr, STEM.half-b.exr, written by
+--keep-halves, M samples per pixel in all) are merged in, weighted by
+their samples: give this run seeds the earlier one did not use (it used
+S to S + P - 1). Not a dependency of the project and not run in CI: its outputs
 are committed under tests/data/.
 
 Setup: python3 -m venv V && V/bin/pip install mitsuba==3.9.1 numpy openexr.
@@ -37,6 +42,15 @@ def write_exr(path, img):
         f.write(path)
 
 
+def read_exr(path):
+    import OpenEXR
+    with OpenEXR.File(path) as f:
+        ch = f.channels()
+        if "RGB" in ch:
+            return np.array(ch["RGB"].pixels, dtype=np.float64)
+        return np.stack([np.array(ch[c].pixels, dtype=np.float64) for c in "RGB"], axis=-1)
+
+
 def parse_window(text):
     name, _, spec = text.rpartition("=")
     rows, cols = spec.split(",")
@@ -54,7 +68,11 @@ def main():
     ap.add_argument("--crop", help="render only rows R0:R1, columns C0:C1 of the image")
     ap.add_argument("--variant", default="llvm_ad_rgb"); ap.add_argument("--seed", type=int, default=1000)
     ap.add_argument("--keep-halves", metavar="DIR", help="also write the two halves' averages there")
+    ap.add_argument("--add", metavar="STEM", help="merge the halves of an earlier render (STEM.half-a.exr, .half-b.exr)")
+    ap.add_argument("--add-spp", type=int, help="samples per pixel of the render --add names")
     a = ap.parse_args()
+    if (a.add is None) != (a.add_spp is None):
+        sys.exit("--add and --add-spp go together")
     import mitsuba as mi
     mi.set_variant(a.variant)
     passes = max(2, a.passes - a.passes % 2)
@@ -86,6 +104,13 @@ def main():
         print(f"pass {p + 1}/{passes}  {time.time() - t0:.0f} s", file=sys.stderr, flush=True)
     seconds = time.time() - t0
     a_half, b_half = (h / (passes // 2) for h in halves)
+    spp = per * passes
+    if a.add:
+        earlier = [read_exr(f"{a.add}.half-{h}.exr") for h in "ab"]
+        if any(e.shape != shape for e in earlier):
+            sys.exit(f"{a.add}: halves of {earlier[0].shape}, this render is {shape}")
+        a_half, b_half = ((mine * spp + old * a.add_spp) / (spp + a.add_spp) for mine, old in zip((a_half, b_half), earlier))
+        spp += a.add_spp
     mean = (a_half + b_half) / 2
     bad = int((~np.isfinite(mean)).sum())
     write_exr(a.out, mean)
@@ -100,11 +125,13 @@ def main():
         return float(np.sqrt((d * d).mean()) / 2)
 
     info = {
-        "scene": a.scene, "width": a.width, "height": a.height, "spp": per * passes, "passes": passes,
+        "scene": a.scene, "width": a.width, "height": a.height, "spp": spp, "passes": passes,
         "seconds": round(seconds, 1), "mitsuba": mi.__version__, "variant": a.variant,
         "noise_rmse": noise(), "mean": float(mean.mean()), "nonfinite": bad,
         "windows": {},
     }
+    if a.add:
+        info["added"] = {"halves": a.add, "spp": a.add_spp, "seed": a.seed}
     if a.crop:
         info["crop"] = {"rows": [r0, r1], "cols": [c0, c1]}
     for w in a.window:

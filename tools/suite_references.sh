@@ -6,9 +6,11 @@
 # Scene 1 is the default room, whose reference ships in tests/data/.
 #
 # usage: tools/suite_references.sh [SPP] [NAME ...]     (default 8192, all)
-# (the references of the hall and the sun window in tests/data/suite/ have
-# 32768, the Cornell box's 16384: at 8192 their noise was larger than
-# photonmap's error after a minute)
+# (in tests/data/suite/ the sun window's reference has 32768, the Cornell
+# box's 16384, the hall's 65536 and the small light's 40960: at 8192 their
+# noise was larger than photonmap's error after a minute. The last two
+# were extended: a second render with other seeds merged with the first's
+# halves, tools/mitsuba_reference.py --add)
 # Needs Mitsuba 3.9.1 in a Python (MITSUBA_PYTHON, default python3) and, for
 # the llvm variant, DRJIT_LIBLLVM_PATH (see tools/mitsuba_reference.py).
 # Hours of CPU: run it by hand, not in CI.
