@@ -12,12 +12,10 @@
 //! measured, log-log, the band of a factor 1.5 drawn); `--replot` only
 //! redraws the plot from the CSV.
 
-use photonmap::metrics::compare_images;
 use photonmap::render::accumulation::Accumulation;
 use photonmap::render::{render_passes, Budget};
 use photonmap::scene::Scene;
 use photonmap::settings::{Settings, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP};
-use photonmap::suite::less_noise;
 use plotters::prelude::*;
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -51,8 +49,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     for s in suite.iter().filter(|s| only.is_empty() || only.contains(&&s.name)) {
         let mut new_rows = Vec::new();
-        let reference = s.load_reference()?;
-        let info = s.reference_info();
+        let scoring = s.scoring()?;
+        let reference = &scoring.reference;
         let file = photonmap::scene::file::load(&s.scene)?;
         let scene = Scene::from_parts(file.parts);
         let settings = Settings {
@@ -69,8 +67,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             if !checkpoints.contains(&r.passes) {
                 return ControlFlow::Continue(());
             }
-            let c = compare_images(r.film, &reference, std::slice::from_ref(&s.caustic)).expect("same size");
-            let measured = [less_noise(c.whole.rmse, info.noise), less_noise(c.windows[0].1.rmse, info.caustic_noise)];
+            let score = scoring.score(r.film).expect("a render of the reference's size");
+            let measured = [score.rmse, score.caustic_rmse];
             for (i, region) in ["image", "caustic"].into_iter().enumerate() {
                 let p = &r.predictions[i].1;
                 let row = Row {

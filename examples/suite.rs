@@ -17,13 +17,13 @@
 //! the notes go; default notes/).
 
 use photonmap::film::{Film, ToneMap};
-use photonmap::metrics::{box_down, compare_images, compare_window, diff_rgb8, Comparison};
+use photonmap::metrics::{box_down, diff_rgb8, Comparison};
 use photonmap::output::{read_exr, write, write_rgb8_image};
 use photonmap::progress::Mode;
 use photonmap::render::{render, render_progressive, Budget};
 use photonmap::scene::Scene;
 use photonmap::settings::{Settings, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP};
-use photonmap::suite::{less_noise, SuiteScene};
+use photonmap::suite::SuiteScene;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -66,18 +66,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all(out_dir.join("suite"))?;
     let mut rows = Vec::new();
     for s in suite.iter().filter(|s| only.is_empty() || only.contains(&s.name)) {
-        let reference = s.load_reference()?;
-        let caustic_reference = s.load_caustic_reference()?;
-        let info = s.reference_info();
-        let noise = (info.noise, info.caustic_noise);
+        let scoring = s.scoring()?;
+        let (reference, info) = (&scoring.reference, &scoring.info);
         let score = |film: &Film, seconds: f64, count: u64| -> Result<Scored, String> {
-            let mut c =
-                compare_images(film, &reference, std::slice::from_ref(&s.caustic)).map_err(|e| e.to_string())?;
-            if let Some(crop) = &caustic_reference {
-                c.windows[0].1 = compare_window(film, c.factor, &s.caustic, crop).map_err(|e| e.to_string())?;
-            }
-            let (rmse, caustic_rmse) = (less_noise(c.whole.rmse, noise.0), less_noise(c.windows[0].1.rmse, noise.1));
-            Ok(Scored { seconds, count, c, rmse, caustic_rmse })
+            let sc = scoring.score(film)?;
+            Ok(Scored { seconds, count, c: sc.comparison, rmse: sc.rmse, caustic_rmse: sc.caustic_rmse })
         };
         // The default command: load, render.
         let t = Instant::now();
@@ -93,7 +86,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "{:<16} default     {:>7.1} s  rmse {:.5}  caustic {:.5}",
             s.name, classic.seconds, classic.rmse, classic.caustic_rmse
         );
-        picture(&out_dir.join("suite").join(format!("{}.png", s.name)), &film, &reference, classic.c.factor)?;
+        picture(&out_dir.join("suite").join(format!("{}.png", s.name)), &film, reference, classic.c.factor)?;
         let progressive = if flag("--no-progressive") {
             None
         } else {
@@ -161,7 +154,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         rows.push(Row {
             name: s.name.clone(),
             spp: info.spp,
-            noise,
+            noise: (info.noise, info.caustic_noise),
             classic,
             progressive,
             mitsuba_classic,

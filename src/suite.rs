@@ -4,7 +4,7 @@
 //! (`examples/suite.rs`) and its tests (`tests/suite.rs`) read it here.
 
 use crate::film::Film;
-use crate::metrics::Window;
+use crate::metrics::{compare_images, compare_window, Comparison, Window};
 use crate::output::read_exr;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -80,6 +80,16 @@ impl SuiteScene {
         self.caustic_reference.as_ref().map(|p| read_exr(p).map_err(|e| format!("{}: {e}", p.display()))).transpose()
     }
 
+    /// The references loaded for scoring renders of this scene.
+    pub fn scoring(&self) -> Result<Scoring, String> {
+        Ok(Scoring {
+            reference: self.load_reference()?,
+            caustic_reference: self.load_caustic_reference()?,
+            caustic: self.caustic.clone(),
+            info: self.reference_info(),
+        })
+    }
+
     pub fn reference_info(&self) -> ReferenceInfo {
         let json = |path: &Path| -> Option<serde_json::Value> {
             serde_json::from_str(&std::fs::read_to_string(path.with_extension("json")).ok()?).ok()
@@ -92,6 +102,39 @@ impl SuiteScene {
             None => v["windows"]["caustic"]["noise_rmse"].as_f64(),
         };
         ReferenceInfo { spp: v["spp"].as_u64(), noise: v["noise_rmse"].as_f64(), caustic_noise }
+    }
+}
+
+/// A suite scene's references, loaded: what scores a render of it the
+/// same way wherever it is scored (the suite's runner, the calibration).
+pub struct Scoring {
+    pub reference: Film,
+    caustic_reference: Option<Film>,
+    caustic: Window,
+    pub info: ReferenceInfo,
+}
+
+/// A render scored against its scene's references.
+pub struct Score {
+    /// Against the whole reference; the caustic window against its own
+    /// reference where the scene has one.
+    pub comparison: Comparison,
+    /// RMSE less the reference's own noise in quadrature ([`less_noise`]):
+    /// the whole image and the caustic window.
+    pub rmse: f64,
+    pub caustic_rmse: f64,
+}
+
+impl Scoring {
+    pub fn score(&self, film: &Film) -> Result<Score, String> {
+        let mut c =
+            compare_images(film, &self.reference, std::slice::from_ref(&self.caustic)).map_err(|e| e.to_string())?;
+        if let Some(crop) = &self.caustic_reference {
+            c.windows[0].1 = compare_window(film, c.factor, &self.caustic, crop).map_err(|e| e.to_string())?;
+        }
+        let rmse = less_noise(c.whole.rmse, self.info.noise);
+        let caustic_rmse = less_noise(c.windows[0].1.rmse, self.info.caustic_noise);
+        Ok(Score { comparison: c, rmse, caustic_rmse })
     }
 }
 

@@ -115,3 +115,26 @@ fn the_manifest_references_load_and_fit_their_windows() {
         }
     }
 }
+
+/// Where a scene has a reference of its caustic window alone, a render is
+/// scored there against it, not against the whole reference's window: the
+/// whole reference with the crop pasted into its window scores zero in the
+/// window and not over the whole image.
+#[test]
+fn a_caustic_window_with_its_own_reference_is_scored_against_it() {
+    let suite = photonmap::suite::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/suite")).unwrap();
+    let s = suite.iter().find(|s| s.caustic_reference.is_some()).expect("a scene with a window reference");
+    let scoring = s.scoring().unwrap();
+    let crop = s.load_caustic_reference().unwrap().unwrap();
+    let mut film = scoring.reference.clone();
+    for row in 0..crop.height {
+        for col in 0..crop.width {
+            let at = (s.caustic.rows.0 + row) as usize * film.width as usize + (s.caustic.cols.0 + col) as usize;
+            film.pixels[at] = crop.get(col, row);
+        }
+    }
+    let score = scoring.score(&film).unwrap();
+    assert_eq!(score.comparison.windows[0].1.rmse, 0.0, "{}", s.name);
+    assert_eq!(score.caustic_rmse, 0.0, "{}", s.name);
+    assert!(score.comparison.whole.rmse > 0.0, "{}: the crop differs from the whole reference's window", s.name);
+}
