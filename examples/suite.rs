@@ -383,8 +383,9 @@ fn below_noise(rows: &[Row], seconds: f64) -> String {
         }
     }
     let mut text = String::from(
-        "An RMSE of 0.00000 and a ratio \"—\": photonmap's error is below the reference's own noise and cannot be \
-         measured against it; Mitsuba's error over the reference's noise bounds the ratio from below",
+        "An RMSE of 0.00000 and a ratio \"—\": photonmap's error cannot be measured against the reference, what \
+         it exceeds the reference's own noise by being within three standard errors of that noise's estimate \
+         (`photonmap::suite::less_noise`); Mitsuba's error over the reference's noise bounds the ratio from below",
     );
     if bounds.is_empty() {
         text.push_str(".\n");
