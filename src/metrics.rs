@@ -47,6 +47,15 @@ impl Window {
         Window { name: "caustic".into(), rows: (r0 * s, r1 * s), cols: (c0 * s, c1 * s) }
     }
 
+    /// Whether the window lies within an image of `w` x `h` pixels.
+    fn fits(&self, w: u32, h: u32) -> Result<(), Mismatch> {
+        if self.rows.1 > h || self.cols.1 > w {
+            let (r0, r1, c0, c1) = (self.rows.0, self.rows.1, self.cols.0, self.cols.1);
+            return Err(Mismatch::Window { name: self.name.clone(), r0, r1, c0, c1, w, h });
+        }
+        Ok(())
+    }
+
     /// Parses `[NAME=]R0:R1,C0:C1` (half-open rows and columns of the
     /// reference); the name defaults to `window<index>`.
     pub fn parse(text: &str, index: usize) -> Result<Window, String> {
@@ -215,17 +224,7 @@ fn finite(test: &Film) -> (Film, u64) {
 pub fn compare_images(test: &Film, reference: &Film, windows: &[Window]) -> Result<Comparison, Mismatch> {
     let factor = reduction_factor((test.width, test.height), (reference.width, reference.height))?;
     for w in windows {
-        if w.rows.1 > reference.height || w.cols.1 > reference.width {
-            return Err(Mismatch::Window {
-                name: w.name.clone(),
-                r0: w.rows.0,
-                r1: w.rows.1,
-                c0: w.cols.0,
-                c1: w.cols.1,
-                w: reference.width,
-                h: reference.height,
-            });
-        }
+        w.fits(reference.width, reference.height)?;
     }
     let (clean, nan_count) = finite(test);
     let reduced = box_down(&clean, factor);
@@ -261,17 +260,7 @@ pub fn compare_window(test: &Film, factor: u32, window: &Window, crop: &Film) ->
     if (crop.width, crop.height) != (w, h) {
         return Err(Mismatch::Size(w, h, crop.width, crop.height));
     }
-    if window.rows.1 * factor > test.height || window.cols.1 * factor > test.width {
-        return Err(Mismatch::Window {
-            name: window.name.clone(),
-            r0: window.rows.0,
-            r1: window.rows.1,
-            c0: window.cols.0,
-            c1: window.cols.1,
-            w: test.width / factor.max(1),
-            h: test.height / factor.max(1),
-        });
-    }
+    window.fits(test.width / factor.max(1), test.height / factor.max(1))?;
     let (clean, _) = finite(test);
     let reduced = box_down(&clean, factor);
     let mut sums = Sums::default();
