@@ -2,6 +2,7 @@
 //! four corners; a pixel's sample points are bilinear in the corners, and the
 //! pixel value is the box-filtered radiance through the pixel's square.
 
+use crate::filter::Filter;
 use crate::math::{Ray, Vertex};
 use glam::{Vec2, Vec3};
 
@@ -19,6 +20,12 @@ pub struct Camera {
     /// Whether the image plane may grow to another aspect ratio (a look-at
     /// camera's may; the course's four corners are the user's exact plane).
     pub widens: bool,
+    /// Where a pixel's samples land about its centre (the course's box by
+    /// default).
+    pub filter: Filter,
+    /// Rays start this far from the eye along the view axis (a near clip
+    /// plane, as in Mitsuba's sensors); 0: at the eye.
+    pub near: f32,
 }
 
 impl Camera {
@@ -36,6 +43,8 @@ impl Camera {
             width,
             height,
             widens: false,
+            filter: Filter::Box,
+            near: 0.0,
         }
     }
 
@@ -138,10 +147,18 @@ impl Camera {
 
     /// The ray through image position (`col` + u.x, `row` + u.y), row 0 at the top.
     pub fn ray(&self, col: u32, row: u32, u: Vec2) -> Ray {
+        let u = self.filter.place(u);
         let fx = (col as f32 + u.x) / self.width as f32;
         let fy = (row as f32 + u.y) / self.height as f32;
         let p = self.upper_left + fx * self.across + fy * self.down;
-        Ray::new(self.eye, (p - self.eye).normalize())
+        let dir = (p - self.eye).normalize();
+        if self.near > 0.0 {
+            // The view axis is the plane's normal, towards the plane.
+            let axis = self.across.cross(self.down).normalize();
+            let axis = if axis.dot(self.upper_left - self.eye) < 0.0 { -axis } else { axis };
+            return Ray::new(self.eye + dir * (self.near / dir.dot(axis)), dir);
+        }
+        Ray::new(self.eye, dir)
     }
 }
 

@@ -25,6 +25,7 @@ pub mod display;
 pub mod error;
 pub mod export;
 pub mod film;
+pub mod filter;
 pub mod integrator;
 pub mod interrupt;
 pub mod light;

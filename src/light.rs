@@ -137,6 +137,82 @@ pub enum Light {
         irradiance: Color,
         reach: (Vertex, f32),
     },
+    /// A point emitting `intensity` (W/sr) into a cone (Mitsuba's `spot`).
+    Spot(Spot),
+}
+
+/// A spot light: intensity I along its axis out to `beam` (the half-angle
+/// of full intensity), then falling linearly in angle to zero at `cutoff`,
+/// as Mitsuba 3's `spot` emitter defines it (src/emitters/spot.cpp).
+#[derive(Clone, Copy, Debug)]
+pub struct Spot {
+    pub position: Vertex,
+    /// z is the spot's axis.
+    pub frame: Frame,
+    pub intensity: Color,
+    cos_cutoff: f32,
+    cos_beam: f32,
+    cutoff: f32,
+    inv_transition: f32,
+    /// ∫ falloff dω over the sphere: power is I times it.
+    solid_angle: f32,
+}
+
+impl Spot {
+    /// A spot at `position` along unit `axis`; angles in degrees, `beam`
+    /// at most `cutoff`.
+    pub fn new(position: Vertex, frame: Frame, intensity: Color, cutoff_deg: f32, beam_deg: f32) -> Self {
+        let cutoff = cutoff_deg.to_radians();
+        let beam = beam_deg.min(cutoff_deg).to_radians();
+        let mut s = Spot {
+            position,
+            frame,
+            intensity,
+            cos_cutoff: cutoff.cos(),
+            cos_beam: beam.cos(),
+            cutoff,
+            inv_transition: 1.0 / (cutoff - beam),
+            solid_angle: 0.0,
+        };
+        // 2π ∫ falloff(θ) sin θ dθ over [0, cutoff], by the midpoint rule
+        // on a fine grid (the falloff is piecewise smooth).
+        let n = 4096;
+        let h = cutoff as f64 / n as f64;
+        let sum: f64 = (0..n)
+            .map(|i| {
+                let t = (i as f64 + 0.5) * h;
+                s.falloff(t.cos() as f32) as f64 * t.sin()
+            })
+            .sum();
+        s.solid_angle = (2.0 * std::f64::consts::PI * sum * h) as f32;
+        s
+    }
+
+    /// The share of the axis' intensity sent at angle acos(cos_theta).
+    #[inline]
+    pub fn falloff(&self, cos_theta: f32) -> f32 {
+        if !(cos_theta > self.cos_cutoff) {
+            return 0.0;
+        }
+        if cos_theta >= self.cos_beam {
+            return 1.0;
+        }
+        ((self.cutoff - cos_theta.clamp(-1.0, 1.0).acos()) * self.inv_transition).clamp(0.0, 1.0)
+    }
+
+    /// Intensity towards unit world direction `dir`.
+    #[inline]
+    pub fn intensity_towards(&self, dir: Vec3) -> Color {
+        self.intensity * self.falloff(dir.dot(self.frame.n))
+    }
+
+    pub fn cos_cutoff(&self) -> f32 {
+        self.cos_cutoff
+    }
+
+    pub fn beam_deg(&self) -> f32 {
+        self.cos_beam.clamp(-1.0, 1.0).acos().to_degrees()
+    }
 }
 
 impl Light {
@@ -201,6 +277,21 @@ impl Light {
             Light::Directional { direction, irradiance, .. } => {
                 Some(Incident { dir: -direction, target: None, intensity: irradiance, prim: None })
             }
+            Light::Spot(spot) => {
+                let to = spot.position - p;
+                let dist2 = to.length_squared();
+                if !(dist2 > 0.0) {
+                    return None;
+                }
+                let dir = to / dist2.sqrt();
+                let intensity = spot.intensity_towards(-dir) / dist2;
+                (intensity.is_finite() && intensity.max_element() > 0.0).then_some(Incident {
+                    dir,
+                    target: Some(spot.position),
+                    intensity,
+                    prim: None,
+                })
+            }
         }
     }
 
@@ -210,6 +301,7 @@ impl Light {
             Light::Area(a) => PI * a.area() * a.radiance,
             Light::Point { intensity, .. } => 4.0 * PI * intensity,
             Light::Directional { irradiance, reach, .. } => PI * reach.1 * reach.1 * irradiance,
+            Light::Spot(s) => s.solid_angle * s.intensity,
         }
     }
 
@@ -217,22 +309,32 @@ impl Light {
     /// uniform position, cosine direction; point lights: uniform direction;
     /// directional: uniform on the covering disk). With these pdfs every
     /// photon of N carries exactly power / N. The departure names the
-    /// light's primitive, if it has one.
+    /// light's primitive, if it has one. The third value multiplies that
+    /// power where the direction is not drawn in proportion to the light's
+    /// intensity (a spot's falloff: uniform in its cone, weighted).
     #[inline]
-    pub fn emit(&self, u_pos: Vec2, u_dir: Vec2) -> (Ray, Option<Departure>) {
+    pub fn emit(&self, u_pos: Vec2, u_dir: Vec2) -> (Ray, Option<Departure>, f32) {
         match *self {
             Light::Area(a) => {
                 let p = a.sample_point(u_pos).point;
                 // Unit to rounding without normalising (`Frame::to_world`):
                 // the first ray waits on it.
                 let dir = a.frame.to_world(cosine_hemisphere(u_dir));
-                (Ray::new(p, dir), Some(Departure { prim: a.prim, outward: true }))
+                (Ray::new(p, dir), Some(Departure { prim: a.prim, outward: true }), 1.0)
             }
-            Light::Point { position, .. } => (Ray::new(position, uniform_cone(u_dir, -1.0).normalize()), None),
+            Light::Point { position, .. } => (Ray::new(position, uniform_cone(u_dir, -1.0).normalize()), None, 1.0),
             Light::Directional { direction, reach, .. } => {
                 let frame = Frame::from_normal(direction);
                 let d = concentric_disk(u_pos) * reach.1;
-                (Ray::new(reach.0 + frame.s * d.x + frame.t * d.y, direction), None)
+                (Ray::new(reach.0 + frame.s * d.x + frame.t * d.y, direction), None, 1.0)
+            }
+            Light::Spot(s) => {
+                let local = uniform_cone(u_dir, s.cos_cutoff);
+                let dir = s.frame.to_world(local).normalize();
+                // (I falloff / pdf) / (I ∫ falloff dω), pdf = 1 / cone's solid angle.
+                let cone = 2.0 * PI * (1.0 - s.cos_cutoff);
+                let weight = if s.solid_angle > 0.0 { s.falloff(local.z) * cone / s.solid_angle } else { 0.0 };
+                (Ray::new(s.position, dir), None, weight)
             }
         }
     }

@@ -16,6 +16,9 @@ pub struct SceneId {
     pub hash: String,
     /// The files read (none for the built-in room).
     pub inputs: Vec<PathBuf>,
+    /// Stand-ins for what a foreign scene file asked and photonmap could
+    /// not render, each with its place (`--substitute`).
+    pub substitutions: Vec<String>,
 }
 
 impl SceneId {
@@ -23,7 +26,7 @@ impl SceneId {
         let mut h = Sha256::new();
         h.update(b"built-in scene: ");
         h.update(name.as_bytes());
-        SceneId { name: name.to_string(), hash: hex(&h.finalize()), inputs: Vec::new() }
+        SceneId { name: name.to_string(), hash: hex(&h.finalize()), inputs: Vec::new(), substitutions: Vec::new() }
     }
 
     /// A scene read from `scene` and `meshes`.
@@ -42,7 +45,7 @@ impl SceneId {
                 h.update(&buf[..n]);
             }
         }
-        Ok(SceneId { name: scene.display().to_string(), hash: hex(&h.finalize()), inputs })
+        Ok(SceneId { name: scene.display().to_string(), hash: hex(&h.finalize()), inputs, substitutions: Vec::new() })
     }
 }
 
@@ -93,6 +96,10 @@ impl Provenance<'_> {
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
+        .chain(
+            (!self.scene.substitutions.is_empty())
+                .then(|| ("substitutions".to_string(), self.scene.substitutions.join("\n"))),
+        )
         .collect()
     }
 }

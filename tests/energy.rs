@@ -42,6 +42,8 @@ fn furnace_with(le: f32, rho: f32, sphere: Option<Material>) -> Scene {
         lights,
         ambient: Color::ZERO,
         camera,
+        one_sided: Vec::new(),
+        paths: photonmap::scene::PathLimits::default(),
     })
 }
 

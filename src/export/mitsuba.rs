@@ -251,6 +251,20 @@ pub fn to_mitsuba(
                     rgb(irradiance)
                 );
             }
+            LightSpec::Spot { position, axis, intensity, cutoff_deg, beam_deg } => {
+                emitters += &flush(&mut out, &mut tri_run);
+                let eye = at(position);
+                let target = eye + axis;
+                let up = if axis.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
+                let _ = write!(
+                    emitters,
+                    "    <emitter type=\"spot\">\n        <transform name=\"to_world\"><lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>\n        <rgb name=\"intensity\" value=\"{}\"/>\n        <float name=\"cutoff_angle\" value=\"{cutoff_deg}\"/>\n        <float name=\"beam_width\" value=\"{beam_deg}\"/>\n    </emitter>\n",
+                    xyz(eye),
+                    xyz(target),
+                    xyz(up),
+                    rgb(intensity * (s * s))
+                );
+            }
         }
     }
     emitters += &flush(&mut out, &mut tri_run);
@@ -519,6 +533,8 @@ mod tests {
             lights,
             ambient: Color::ZERO,
             camera: Scene::tncg15_parts(Eye::One).camera,
+            one_sided: Vec::new(),
+            paths: crate::scene::PathLimits::default(),
         }
     }
 

@@ -39,17 +39,25 @@ impl Integrator for PathIntegrator<'_> {
         let mut count_emission = true;
         // Whether every vertex so far was specular (the path is E S* so far).
         let mut specular_chain = true;
+        // This hit is the path's vertex depth + 1 after the eye; a scene
+        // may limit how many there are (Mitsuba's max_depth).
+        let limits = self.scene.paths;
+        let within = |vertices: u32| limits.max_depth.is_none_or(|m| vertices <= m);
         for depth in 0..MAX_DEPTH {
+            if !within(depth + 1) {
+                break;
+            }
             ctx.counters.rays += 1;
             let Some(hit) = self.scene.intersect(&ray, departure) else { break };
             throughput *= self.scene.transmittance(departure, hit.t);
-            let material = self.scene.material(hit.prim);
+            let material = self.scene.material_seen(&hit, ray.dir);
             let wanted = match part {
                 Part::All => true,
                 Part::Emitted => specular_chain,
                 Part::Reflected => !specular_chain,
             };
-            if count_emission && wanted {
+            let hidden = depth == 0 && limits.hide_emitters;
+            if count_emission && wanted && !hidden {
                 // A light's own surface, or a glowing one; after a diffuse
                 // bounce the shadow rays counted it.
                 radiance += throughput * self.scene.emitted(hit.prim, ray.dir);
@@ -67,7 +75,7 @@ impl Integrator for PathIntegrator<'_> {
                 };
                 Scatter { wi: b.wi, weight: b.scale, lobe: Lobe::Specular }
             } else {
-                if material.diffuse_rho().is_some() || material.glossy().is_some() {
+                if (material.diffuse_rho().is_some() || material.glossy().is_some()) && within(depth + 2) {
                     let brdf = |w| material.eval(wo, frame.to_local(w));
                     let direct = direct_light(self.scene, &hit, n, brdf, self.shadow_rays, self.skip, ctx);
                     radiance += throughput * ctx.checked(direct, "path direct");

@@ -182,9 +182,14 @@ impl<'a> PhotonIntegrator<'a> {
         };
         let through = self.scene.transmittance(departure, hit.t);
         let w = w * through;
-        let material = self.scene.material(hit.prim);
+        let material = self.scene.material_seen(&hit, ray.dir);
+        // This hit is the path's vertex depth + 1 after the eye; a scene
+        // may limit how many there are (`PathLimits`).
+        let limits = self.scene.paths;
+        let within = |vertices: u32| limits.max_depth.is_none_or(|m| vertices <= m);
         // A light's own surface, or a glowing one.
-        let emitted = if part == Part::Reflected { Color::ZERO } else { self.scene.emitted(hit.prim, ray.dir) };
+        let seen = part != Part::Reflected && within(depth + 1) && !(depth == 0 && limits.hide_emitters);
+        let emitted = if seen { self.scene.emitted(hit.prim, ray.dir) } else { Color::ZERO };
         if material.is_emitter() {
             return through * emitted;
         }
@@ -192,10 +197,11 @@ impl<'a> PhotonIntegrator<'a> {
         let wo = frame.to_local(-ray.dir);
         let branches = material.specular_branches(wo, entering, Transport::Radiance);
         let mut radiance = emitted;
-        if !branches.is_empty() {
+        if !branches.is_empty() && within(depth + 2) {
             radiance = self.specular(&hit, &frame, &branches, depth, part, w, sh) + radiance;
         }
-        if part != Part::Emitted && (material.diffuse_rho().is_some() || material.glossy().is_some()) {
+        let reflects = material.diffuse_rho().is_some() || material.glossy().is_some();
+        if part != Part::Emitted && reflects && within(depth + 2) {
             radiance += self.surface(&hit, material, &frame, wo, w, sh);
         }
         through * radiance
@@ -246,6 +252,12 @@ impl<'a> PhotonIntegrator<'a> {
         let brdf = |w: glam::Vec3| material.eval(wo, frame.to_local(w));
         let direct = direct_light(self.scene, hit, n, brdf, self.settings.shadow_rays, self.settings.skip, sh.ctx);
         let (mut caustic, mut indirect) = (Color::ZERO, Color::ZERO);
+        // Longer paths are the maps' and gathering's; a scene that limits
+        // paths to two vertices has only direct light here (a limit of
+        // three or more is not offered for photon mapping).
+        if self.scene.paths.max_depth.is_some() {
+            return self.checked(direct, "direct", sh);
+        }
         if let Some(rho) = material.diffuse_rho() {
             caustic = self.caustic(hit, n, rho, sh);
             indirect = self.indirect(hit, n, rho, w, sh);
@@ -366,7 +378,7 @@ impl<'a> PhotonIntegrator<'a> {
                 break;
             };
             weight *= self.scene.transmittance(Some(dep), y.t);
-            let material = self.scene.material(y.prim);
+            let material = self.scene.material_seen(&y, ray.dir);
             if from == Lobe::Glossy && specular {
                 found += weight * self.scene.emitted(y.prim, ray.dir);
             }

@@ -113,8 +113,8 @@ fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> (Option<usize>, Opt
     match pass {
         Pass::Global => {
             // The light's natural distribution: each photon carries power / n.
-            let (ray, departure) = light.emit(next_2d(rng), next_2d(rng));
-            (None, Some((ray, departure, light.power() * scale)))
+            let (ray, departure, weight) = light.emit(next_2d(rng), next_2d(rng));
+            (None, Some((ray, departure, light.power() * (scale * weight))))
         }
         Pass::Caustic => {
             let targets = scene.specular_targets();
@@ -164,6 +164,7 @@ fn aim(
     let (origin, departure) = match light {
         Light::Area(a) => (a.sample_point(next_2d(rng)).point, Some(Departure { prim: a.prim, outward: true })),
         Light::Point { position, .. } => (*position, None),
+        Light::Spot(s) => (s.position, None),
         Light::Directional { .. } => unreachable!("handled above"),
     };
     let (axis, cos_max) = chosen.cone_from(origin);
@@ -199,6 +200,7 @@ fn aim(
             a.radiance * cos_emit * a.area()
         }
         Light::Point { intensity, .. } => *intensity,
+        Light::Spot(s) => s.intensity_towards(dir.normalize()),
         Light::Directional { .. } => unreachable!("handled above"),
     };
     Some((Ray::new(origin, dir), departure, intensity * scale / pdf_dir))
@@ -302,7 +304,7 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
         return (false, false);
     };
     *power *= scene.transmittance(*departure, hit.t);
-    let material = scene.material(hit.prim);
+    let material = scene.material_seen(&hit, ray.dir);
     let (frame, entering) = hit.scattering_frame(ray.dir, material);
     let first_specular = bounce_now == 0 && material.is_specular();
     let stop = (false, first_specular);

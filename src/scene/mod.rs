@@ -11,6 +11,8 @@ use crate::math::{max_component, offset_ray_origin, Color, Frame, Ray, Vertex};
 use crate::sampling::Discrete;
 pub mod file;
 pub mod mesh;
+pub mod mitsuba;
+pub mod ply;
 pub mod procedural;
 mod room;
 
@@ -165,6 +167,10 @@ pub struct Scene {
     targets: Vec<Target>,
     /// The lights by power (largest channel): the photon passes' choice.
     light_pick: Option<Discrete>,
+    /// Per material, the material seen from behind its geometric normal
+    /// (itself where two-sided); empty where every material is.
+    back_material: Vec<u32>,
+    pub paths: PathLimits,
 }
 
 /// Marks a primitive that is not a light's surface.
@@ -192,6 +198,14 @@ pub enum LightSpec {
         direction: Vec3,
         irradiance: Color,
     },
+    /// A cone of light from `position` along unit `axis` ([`crate::light::Spot`]).
+    Spot {
+        position: Vertex,
+        axis: Vec3,
+        intensity: Color,
+        cutoff_deg: f32,
+        beam_deg: f32,
+    },
 }
 
 /// A scene's ingredients, before [`Scene::from_parts`] derives what the
@@ -205,6 +219,23 @@ pub struct SceneParts {
     pub lights: Vec<LightSpec>,
     pub ambient: Color,
     pub camera: Camera,
+    /// Per material: whether it reflects only on the front of the
+    /// geometric normal, black behind (Mitsuba's BSDFs but `twosided` and
+    /// the dielectrics). Empty: every material is two-sided.
+    pub one_sided: Vec<bool>,
+    pub paths: PathLimits,
+}
+
+/// What the scene says of the light paths to render (Mitsuba's
+/// integrator's `max_depth` and `hide_emitters`); the defaults are every
+/// path, lights seen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PathLimits {
+    /// The most vertices a path may have after the eye: 1 is lights seen
+    /// directly, 2 adds direct light; `None`: unlimited.
+    pub max_depth: Option<u32>,
+    /// Lights seen directly from the eye are black.
+    pub hide_emitters: bool,
 }
 
 impl SceneParts {
@@ -234,6 +265,10 @@ impl SceneParts {
                     *intensity *= s * s;
                 }
                 LightSpec::Directional { .. } => {}
+                LightSpec::Spot { position, intensity, .. } => {
+                    *position *= s;
+                    *intensity *= s * s;
+                }
             }
         }
         self.camera = self.camera.scaled(s);
@@ -270,7 +305,16 @@ impl Scene {
     /// `parts.prims`, in order), so that camera rays see them and photons are
     /// absorbed by them.
     pub fn from_parts(parts: SceneParts) -> Self {
-        let SceneParts { mut prims, shading_normals, mut materials, lights: specs, ambient, camera } = parts;
+        let SceneParts { mut prims, shading_normals, mut materials, lights: specs, ambient, camera, one_sided, paths } =
+            parts;
+        // A one-sided material's back is a black surface of its own.
+        let back_material = if one_sided.iter().any(|&b| b) {
+            let black = materials.len() as u32;
+            materials.push(Material::Lambertian { rho: Color::ZERO });
+            (0..black).map(|m| if one_sided.get(m as usize) == Some(&true) { black } else { m }).collect()
+        } else {
+            Vec::new()
+        };
         let mut prim_light = vec![NO_LIGHT; prims.len()];
         let mut lights = Vec::new();
         let emitter = materials.len() as u32;
@@ -309,6 +353,12 @@ impl Scene {
                 LightSpec::Directional { direction, irradiance } => {
                     lights.push(Light::Directional { direction, irradiance, reach: (Vec3::ZERO, 0.0) });
                 }
+                LightSpec::Spot { position, axis, intensity, cutoff_deg, beam_deg } => {
+                    lo = lo.min(position);
+                    hi = hi.max(position);
+                    let frame = crate::math::Frame::from_normal(axis);
+                    lights.push(Light::Spot(crate::light::Spot::new(position, frame, intensity, cutoff_deg, beam_deg)));
+                }
             }
         }
         if !(lo.x <= hi.x) {
@@ -339,6 +389,8 @@ impl Scene {
             bounds: (lo, hi),
             targets,
             light_pick,
+            back_material,
+            paths,
         }
     }
 
@@ -425,6 +477,17 @@ impl Scene {
         self.accel.occluded(ray, departure, t_max, ignore)
     }
 
+    /// The material a ray travelling along `dir` meets at `hit`: a one-sided
+    /// material's black back where it arrives behind the geometric normal.
+    #[inline]
+    pub fn material_seen(&self, hit: &Hit, dir: Vec3) -> &Material {
+        let m = self.prim_material[hit.prim as usize];
+        if self.back_material.is_empty() || dir.dot(hit.normal) < 0.0 {
+            return &self.materials[m as usize];
+        }
+        &self.materials[self.back_material[m as usize] as usize]
+    }
+
     pub fn material(&self, prim: u32) -> &Material {
         &self.materials[self.prim_material[prim as usize] as usize]
     }
@@ -504,6 +567,8 @@ impl Scene {
     pub fn needs(&self) -> Needs {
         let lit = crate::math::max_component(self.emitted_power()) > 0.0;
         let diffuse = self.prim_material.iter().any(|&m| self.materials[m as usize].diffuse_rho().is_some());
+        // Paths of at most two vertices (lights seen, direct light) read no map.
+        let lit = lit && self.paths.max_depth.is_none_or(|d| d > 2);
         Needs {
             // Caustic paths need a mirror or glass object and a diffuse
             // surface to land on.

@@ -131,6 +131,8 @@ impl Scene {
             }],
             ambient: Color::ZERO,
             camera,
+            one_sided: Vec::new(),
+            paths: crate::scene::PathLimits::default(),
         }
     }
 }

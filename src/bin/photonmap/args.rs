@@ -107,3 +107,12 @@ pub fn parse_windows(texts: &[String]) -> Result<Vec<Window>, String> {
         .collect::<Result<_, _>>()
         .map_err(|e| format!("--window: {e}"))
 }
+
+/// `NAME=VALUE` for -D: a parameter name is letters, digits and `_`.
+pub fn parse_define(s: &str) -> Result<(String, String), String> {
+    let (name, value) = s.split_once('=').ok_or_else(|| format!("'{s}' is not NAME=VALUE"))?;
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return Err(format!("'{name}' is not a parameter name (letters, digits and _)"));
+    }
+    Ok((name.to_string(), value.to_string()))
+}

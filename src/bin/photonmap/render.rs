@@ -39,11 +39,21 @@ const REWRITE_SECONDS: f64 = 10.0;
 /// Rendering (the default command).
 #[derive(clap::Args, Debug)]
 pub struct RenderArgs {
-    /// Render this scene file (TOML, notes/scene-format.md) instead of the
-    /// built-in room; its camera, resolution and rays_per_pixel_edge are the
-    /// defaults of --width, --height and --spp.
-    #[arg(long, value_name = "SCENE.toml", conflicts_with = "eye")]
+    /// Render this scene file instead of the built-in room: photonmap's TOML
+    /// (notes/scene-format.md) or Mitsuba 3's XML (.xml, notes/mitsuba.md);
+    /// its camera, resolution and samples per pixel are the defaults of
+    /// --width, --height and --spp.
+    #[arg(long, value_name = "SCENE.toml|SCENE.xml", conflicts_with = "eye")]
     scene: Option<PathBuf>,
+    /// Set a Mitsuba scene's parameter $NAME, as Mitsuba's -D does
+    /// (repeatable; wins over the file's <default>).
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define, requires = "scene")]
+    defines: Vec<(String, String)>,
+    /// Render a Mitsuba scene even where a BSDF or emitter is not supported:
+    /// a grey diffuse BSDF stands in, an emitter is left out; each is listed
+    /// on stderr and in the EXR's header.
+    #[arg(long, requires = "scene")]
+    substitute: bool,
     /// Output images; the extension picks the format: .exr (linear float
     /// radiance, with how it was made in its header, and for progressive
     /// renders the error estimate's layers), .png or .ppm (8-bit,
@@ -257,7 +267,33 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
             let name = format!("built-in TNCG15 room, eye {}", if eye == Eye::Two { 2 } else { 1 });
             (Scene::tncg15(eye), 4, SceneId::built_in(&name))
         }
+        Some(path) if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("xml")) => {
+            let options =
+                photonmap::scene::mitsuba::Options { defines: cli.defines.clone(), substitute: cli.substitute };
+            let mut imported =
+                photonmap::scene::mitsuba::load(path, &options).map_err(|e| Error::Invalid(e.to_string()))?;
+            if let (Some(e), IntegratorArg::Photon) = (imported.photon_limit.take(), cli.integrator) {
+                if !cli.substitute {
+                    return Err(Error::Invalid(e.to_string()));
+                }
+                imported.substitutions.push(format!("{e} (rendered with paths of every length)"));
+                imported.file.parts.paths.max_depth = None;
+            }
+            for s in &imported.substitutions {
+                eprintln!("substituted: {s}");
+            }
+            let mut id = SceneId::from_files(path, &imported.inputs[1..])
+                .map_err(|e| Error::Io { path: path.clone(), source: e })?;
+            id.substitutions = imported.substitutions;
+            (Scene::from_parts(imported.file.parts), imported.spp, id)
+        }
         Some(path) => {
+            if !cli.defines.is_empty() || cli.substitute {
+                return Err(Error::Invalid(format!(
+                    "{}: -D and --substitute are for Mitsuba scenes (.xml)",
+                    path.display()
+                )));
+            }
             let file = photonmap::scene::file::load(path).map_err(|e| Error::Invalid(e.to_string()))?;
             if !file.not_physical.is_empty() {
                 let all: Vec<String> = file.not_physical.iter().map(|e| e.to_string()).collect();

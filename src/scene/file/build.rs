@@ -203,6 +203,8 @@ impl Builder<'_> {
             lights: self.lights,
             ambient,
             camera,
+            one_sided: Vec::new(),
+            paths: crate::scene::PathLimits::default(),
         };
         Ok(SceneFile {
             parts,
@@ -231,7 +233,9 @@ impl Builder<'_> {
                 LightSpec::Area { surface, radiance, .. } => {
                     pi * surface.area() as f64 * radiance.as_dvec3().max_element()
                 }
-                LightSpec::Point { intensity, .. } => 4.0 * pi * intensity.as_dvec3().max_element(),
+                LightSpec::Point { intensity, .. } | LightSpec::Spot { intensity, .. } => {
+                    4.0 * pi * intensity.as_dvec3().max_element()
+                }
                 LightSpec::Directional { irradiance, .. } => pi * reach * reach * irradiance.as_dvec3().max_element(),
             })
             .collect();

@@ -1,0 +1,89 @@
+//! Top-level `<emitter>` plugins (an `area` emitter belongs to a shape:
+//! shapes.rs). Placement as Mitsuba 3 defines it (src/emitters/*.cpp): a
+//! point light at `position` or `to_world`'s origin; a directional light
+//! along `direction` or `to_world`'s +z; a spot light at `to_world`'s
+//! origin shining along its +z.
+
+use super::props::Plugin;
+use super::spectrum::Use;
+use super::Builder;
+use crate::math::Color;
+use crate::scene::file::SceneError;
+use crate::scene::LightSpec;
+use glam::{DAffine3, DVec3};
+
+impl Builder<'_> {
+    pub(super) fn emitter(&mut self, p: &Plugin) -> Result<(), SceneError> {
+        match light_of(p) {
+            Ok(spec) => {
+                self.lights.push(spec);
+                self.origins.lights.push(super::place(p));
+                Ok(())
+            }
+            Err(e) => self.substitute(p, "the emitter is left out", e),
+        }
+    }
+}
+
+fn light_of(p: &Plugin) -> Result<LightSpec, SceneError> {
+    let spec = match p.kind {
+        "point" => {
+            let position = match (p.point("position")?, p.transform("to_world")?) {
+                (Some(_), Some(_)) => return Err(p.refuse("give either position or to_world, not both")),
+                (Some(x), None) => x,
+                (None, m) => m.unwrap_or(DAffine3::IDENTITY).translation,
+            };
+            let intensity = p.color("intensity", Use::Emission)?.unwrap_or(Color::ONE);
+            p.finish("position, to_world, intensity")?;
+            LightSpec::Point { position: position.as_vec3(), intensity, falloff: 2.0, dead_distance: 0.0 }
+        }
+        "directional" => {
+            let direction = match (p.point("direction")?, p.transform("to_world")?) {
+                (Some(_), Some(_)) => return Err(p.refuse("give either direction or to_world, not both")),
+                (Some(d), None) => d,
+                (None, m) => m.unwrap_or(DAffine3::IDENTITY).transform_vector3(DVec3::Z),
+            };
+            let direction =
+                direction.try_normalize().ok_or_else(|| p.fail(p.loc(), "direction", "must not be zero"))?.as_vec3();
+            let irradiance = p.color("irradiance", Use::Emission)?.unwrap_or(Color::ONE);
+            p.finish("direction, to_world, irradiance")?;
+            LightSpec::Directional { direction, irradiance }
+        }
+        "spot" => {
+            let m = p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
+            let intensity = p.color("intensity", Use::Emission)?.unwrap_or(Color::ONE);
+            let cutoff = p.float_in("cutoff_angle", 20.0, 1e-3, 180.0)?;
+            let beam = p.float_in("beam_width", cutoff * 0.75, 0.0, 180.0)?;
+            p.finish("to_world, intensity, cutoff_angle, beam_width")?;
+            let axis = m
+                .transform_vector3(DVec3::Z)
+                .try_normalize()
+                .ok_or_else(|| p.fail(p.loc(), "to_world", "is singular"))?;
+            LightSpec::Spot {
+                position: m.translation.as_vec3(),
+                axis: axis.as_vec3(),
+                intensity,
+                cutoff_deg: cutoff as f32,
+                beam_deg: beam.min(cutoff) as f32,
+            }
+        }
+        "area" => return Err(p.refuse("an area emitter must be nested in the <shape> that emits")),
+        "constant" | "envmap" => {
+            return Err(p.refuse(format!("the '{}' emitter (light from everywhere) is not supported yet", p.kind)))
+        }
+        k => {
+            return Err(
+                p.refuse(format!("the '{k}' emitter is not supported yet (point, directional, spot and area are)"))
+            )
+        }
+    };
+    if let LightSpec::Point { intensity: c, .. }
+    | LightSpec::Spot { intensity: c, .. }
+    | LightSpec::Directional { irradiance: c, .. } = spec
+    {
+        if c.min_element() < 0.0 {
+            return Err(p.refuse("emission must not be negative"));
+        }
+    }
+    Ok(spec)
+}

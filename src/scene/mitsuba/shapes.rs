@@ -1,0 +1,323 @@
+//! `<shape>` plugins as primitives, each placed by its `to_world` (and an
+//! instance's), with its BSDF and, for an area emitter, a light per
+//! triangle. Mitsuba's shapes in their own frames (src/shapes/*.cpp):
+//! `rectangle` is [-1, 1]^2 at z = 0 facing +z, `cube` is [-1, 1]^3,
+//! `disk` the unit disk facing +z, `sphere` a `center` and `radius`.
+//!
+//! Meshes keep their vertex normals; a mesh without them gets
+//! angle-weighted vertex normals (Thürmer and Wüthrich 1998), as Mitsuba
+//! computes them, unless `face_normals` is set. A transform that mirrors
+//! reverses the winding, so that the front stays where the normals point.
+
+use super::props::Plugin;
+use super::spectrum::Use;
+use super::Builder;
+use crate::light::Emitting;
+use crate::math::Color;
+use crate::scene::file::SceneError;
+use crate::scene::mesh::load_obj;
+use crate::scene::ply::load_ply;
+use crate::scene::{LightSpec, Prim};
+use crate::shape::{Disk, Ellipsoid, Shape, Sphere, Triangle};
+use glam::{Affine3A, DAffine3, DVec3, Vec3};
+use std::collections::HashMap;
+
+/// Triangles in world space with their corners' normals, if smooth.
+struct Tris {
+    tris: Vec<[Vec3; 3]>,
+    normals: Option<Vec<[Vec3; 3]>>,
+}
+
+impl Builder<'_> {
+    pub(super) fn shape(&mut self, p: &Plugin, outer: DAffine3) -> Result<(), SceneError> {
+        match p.kind {
+            // Built where an instance names it.
+            "shapegroup" => {
+                let children = p.objects("shape")?;
+                p.finish("nested <shape>s")?;
+                if let Some(c) = children.iter().find(|c| c.kind == "shapegroup" || c.kind == "instance") {
+                    return Err(c.refuse("a shapegroup cannot hold another shapegroup or an instance"));
+                }
+                return Ok(());
+            }
+            "instance" => {
+                let group = p.object("shape")?.ok_or_else(|| p.refuse("an instance needs a <ref> to a shapegroup"))?;
+                let to_world = p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
+                p.finish("a shapegroup reference, to_world")?;
+                if group.kind != "shapegroup" {
+                    return Err(group.refuse("an instance must refer to a shapegroup"));
+                }
+                let m = outer * to_world;
+                for child in group.objects("shape")? {
+                    self.shape(&child, m)?;
+                }
+                return Ok(());
+            }
+            _ => {}
+        }
+        for medium in p.objects("medium")? {
+            return Err(medium.refuse("participating media are not supported yet"));
+        }
+        let bsdf = p.object("bsdf")?;
+        let material = self.material(bsdf.as_ref())?;
+        let emitter = p.object("emitter")?;
+        let radiance = match &emitter {
+            None => None,
+            Some(e) if e.kind == "area" => {
+                let r = e.color("radiance", Use::Emission)?.unwrap_or(Color::ONE);
+                e.finish("radiance")?;
+                if r.min_element() < 0.0 {
+                    return Err(e.fail(e.loc(), "radiance", "must not be negative"));
+                }
+                Some(r)
+            }
+            Some(e) => return Err(e.refuse(format!("a shape's emitter must be 'area', got '{}'", e.kind))),
+        };
+        let to_world = outer * p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
+        let flip = p.boolean("flip_normals", false)?;
+        if to_world.matrix3.determinant() == 0.0 {
+            return Err(p.fail(p.loc(), "to_world", "the transform is singular"));
+        }
+        let object = self.new_object();
+        let mesh = match p.kind {
+            "obj" | "ply" => {
+                let face_normals = p.boolean("face_normals", false)?;
+                let (name, loc) = p.string("filename")?.ok_or_else(|| p.refuse("needs a filename"))?;
+                let path = self.resolve(&name, &loc)?;
+                // Texture coordinates' orientation: read, no use yet.
+                p.boolean("flip_tex_coords", true)?;
+                let (tris, normals, shared) = if p.kind == "obj" {
+                    let m = load_obj(&path).map_err(|e| p.fail(&loc, "filename", e))?;
+                    (m.triangles, m.normals, None)
+                } else {
+                    let m = load_ply(&path).map_err(|e| p.fail(&loc, "filename", e))?;
+                    let tris: Vec<[Vec3; 3]> = m.triangles.iter().map(|t| t.map(|i| m.positions[i as usize])).collect();
+                    let normals = m.normals.as_ref().map(|n| m.triangles.iter().map(|t| t.map(|i| n[i as usize])).collect());
+                    (tris, normals, Some(m.triangles.clone()))
+                };
+                let normals = match (face_normals, normals) {
+                    (true, _) => None,
+                    (false, Some(n)) => Some(n),
+                    (false, None) => Some(smooth_normals(&tris, shared.as_deref())),
+                };
+                Mesh::Tris(Tris { tris, normals })
+            }
+            "rectangle" => {
+                let c = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]].map(|[x, y]| Vec3::new(x, y, 0.0));
+                Mesh::Tris(Tris { tris: vec![[c[0], c[1], c[2]], [c[0], c[2], c[3]]], normals: None })
+            }
+            "cube" => Mesh::Tris(Tris { tris: cube(), normals: None }),
+            "sphere" => {
+                let center = p.point("center")?.unwrap_or(DVec3::ZERO);
+                let radius = p.float_in("radius", 1.0, 0.0, 1e15)?;
+                if flip {
+                    return Err(p.fail(p.loc(), "flip_normals", "a sphere with inward normals is not supported yet"));
+                }
+                let m = to_world * DAffine3::from_translation(center) * DAffine3::from_scale(DVec3::splat(radius));
+                Mesh::Analytic(match similarity(&m) {
+                    Some(s) => Shape::Sphere(Sphere { center: m.translation.as_vec3(), radius: s as f32 }),
+                    None => Shape::Ellipsoid(
+                        Ellipsoid::new(affine(&m)).ok_or_else(|| p.fail(p.loc(), "to_world", "the transform is singular"))?,
+                    ),
+                })
+            }
+            "disk" => {
+                if flip {
+                    return Err(p.fail(p.loc(), "flip_normals", "a disk with flipped normals is not supported yet"));
+                }
+                let s = similarity(&to_world).ok_or_else(|| {
+                    p.fail(p.loc(), "to_world", "a disk stretched into an ellipse is not supported (scale it uniformly)")
+                })?;
+                let normal = to_world.matrix3.z_axis.normalize().as_vec3();
+                Mesh::Analytic(Shape::Disk(Disk { center: to_world.translation.as_vec3(), normal, radius: s as f32 }))
+            }
+            k => {
+                return Err(p.refuse(format!(
+                    "the '{k}' shape is not supported yet (obj, ply, rectangle, cube, sphere, disk, shapegroup, instance are)"
+                )))
+            }
+        };
+        p.finish("filename, face_normals, flip_normals, flip_tex_coords, to_world, center, radius, bsdf, emitter")?;
+        match mesh {
+            Mesh::Analytic(shape) => match (radiance, shape) {
+                (None, shape) => self.prims.push(Prim { shape, material, object }),
+                (Some(radiance), Shape::Disk(d)) => {
+                    self.lights.push(LightSpec::Area { surface: Emitting::Disk(d), radiance, material: Some(material) })
+                }
+                (Some(_), _) => {
+                    return Err(
+                        p.refuse("an emitting sphere is not supported yet (emitting meshes, rectangles and disks are)")
+                    )
+                }
+            },
+            Mesh::Tris(t) => self.push_triangles(t, &to_world, flip, material, object, radiance),
+        }
+        Ok(())
+    }
+
+    fn push_triangles(
+        &mut self,
+        mesh: Tris,
+        to_world: &DAffine3,
+        flip: bool,
+        material: u32,
+        object: u32,
+        radiance: Option<Color>,
+    ) {
+        let normal_map = to_world.matrix3.inverse().transpose();
+        // A mirroring transform and flip_normals each turn the surface over.
+        let reverse = (to_world.matrix3.determinant() < 0.0) != flip;
+        let sign = if flip { -1.0 } else { 1.0 };
+        for (i, tri) in mesh.tris.iter().enumerate() {
+            let mut v = tri.map(|p| to_world.transform_point3(p.as_dvec3()).as_vec3());
+            let mut n = mesh
+                .normals
+                .as_ref()
+                .map(|ns| ns[i].map(|n| (normal_map * n.as_dvec3() * sign).normalize_or_zero().as_vec3()));
+            if reverse {
+                v.swap(1, 2);
+                if let Some(n) = &mut n {
+                    n.swap(1, 2);
+                }
+            }
+            let mut t = Triangle::new(v[0], v[1], v[2]);
+            if !(t.area() > 0.0) {
+                continue;
+            }
+            if let Some(radiance) = radiance {
+                self.lights.push(LightSpec::Area {
+                    surface: Emitting::Triangle(t),
+                    radiance,
+                    material: Some(material),
+                });
+                continue;
+            }
+            if let Some(n) = n.filter(|n| n.iter().all(|c| c.length_squared() > 0.0)) {
+                // Shading normals on the winding's side, as the renderer expects.
+                let n = if (n[0] + n[1] + n[2]).dot(t.normal) < 0.0 { n.map(|c| -c) } else { n };
+                if n.iter().any(|c| (*c - t.normal).length_squared() > 1e-12) {
+                    t.shading = self.shading_normals.len() as u32;
+                    self.shading_normals.push(n);
+                }
+            }
+            self.prims.push(Prim { shape: Shape::Triangle(t), material, object });
+        }
+    }
+}
+
+enum Mesh {
+    Tris(Tris),
+    Analytic(Shape),
+}
+
+/// The uniform scale of a transform made of rotations, translations and
+/// uniform scales (`None` if it shears or scales unevenly).
+fn similarity(m: &DAffine3) -> Option<f64> {
+    let [x, y, z] = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis];
+    let s = x.length();
+    let tol = 1e-6 * s;
+    let fits = (y.length() - s).abs() <= tol
+        && (z.length() - s).abs() <= tol
+        && x.dot(y).abs() <= tol * s
+        && x.dot(z).abs() <= tol * s
+        && y.dot(z).abs() <= tol * s;
+    (fits && s > 0.0).then_some(s)
+}
+
+fn affine(m: &DAffine3) -> Affine3A {
+    Affine3A::from_mat3_translation(m.matrix3.as_mat3(), m.translation.as_vec3())
+}
+
+/// [-1, 1]^3 as 12 outward-wound triangles.
+fn cube() -> Vec<[Vec3; 3]> {
+    let mut out = Vec::new();
+    for axis in 0..3 {
+        for side in [-1.0f32, 1.0] {
+            let mut n = Vec3::ZERO;
+            n[axis] = side;
+            let (u, v) = {
+                let mut u = Vec3::ZERO;
+                let mut v = Vec3::ZERO;
+                u[(axis + 1) % 3] = 1.0;
+                v[(axis + 2) % 3] = 1.0;
+                (u, v)
+            };
+            let c = [n - u - v, n + u - v, n + u + v, n - u + v];
+            // Wound counter-clockwise seen from outside.
+            let (a, b) = if side > 0.0 { (1, 3) } else { (3, 1) };
+            out.push([c[0], c[a], c[2]]);
+            out.push([c[0], c[2], c[b]]);
+        }
+    }
+    out
+}
+
+/// Angle-weighted vertex normals, shared by the corners of one vertex:
+/// the vertex indices where a file has them, else equal positions.
+fn smooth_normals(tris: &[[Vec3; 3]], indices: Option<&[[u32; 3]]>) -> Vec<[Vec3; 3]> {
+    let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
+    let corner_ids: Vec<[u32; 3]> = match indices {
+        Some(ix) => ix.to_vec(),
+        None => tris
+            .iter()
+            .map(|t| {
+                t.map(|p| {
+                    let n = ids.len() as u32;
+                    *ids.entry(p.to_array().map(f32::to_bits)).or_insert(n)
+                })
+            })
+            .collect(),
+    };
+    let count = corner_ids.iter().flatten().max().map_or(0, |m| *m as usize + 1);
+    let mut acc = vec![Vec3::ZERO; count];
+    for (t, ids) in tris.iter().zip(&corner_ids) {
+        let Some(n) = (t[1] - t[0]).cross(t[2] - t[0]).try_normalize() else { continue };
+        for k in 0..3 {
+            let a = (t[(k + 1) % 3] - t[k]).normalize_or_zero();
+            let b = (t[(k + 2) % 3] - t[k]).normalize_or_zero();
+            acc[ids[k] as usize] += n * a.dot(b).clamp(-1.0, 1.0).acos();
+        }
+    }
+    corner_ids.iter().map(|ids| ids.map(|i| acc[i as usize].normalize_or_zero())).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_cube_faces_outwards_and_closes() {
+        let c = cube();
+        assert_eq!(c.len(), 12);
+        let mut area = 0.0;
+        for t in &c {
+            let n = (t[1] - t[0]).cross(t[2] - t[0]);
+            let centre = (t[0] + t[1] + t[2]) / 3.0;
+            assert!(n.dot(centre) > 0.0, "{t:?} faces inwards");
+            area += 0.5 * n.length();
+        }
+        assert!((area - 24.0).abs() < 1e-5);
+    }
+
+    /// A flat fan gets the plane's normal at every corner; a corner of a
+    /// cube gets the diagonal.
+    #[test]
+    fn smooth_normals_weigh_by_angle() {
+        let quad = [[Vec3::ZERO, Vec3::X, Vec3::ONE.with_z(0.0)], [Vec3::ZERO, Vec3::ONE.with_z(0.0), Vec3::Y]];
+        for n in smooth_normals(&quad, None).iter().flatten() {
+            assert!((*n - Vec3::Z).length() < 1e-6);
+        }
+        let c = cube();
+        let n = smooth_normals(&c, None);
+        let corner = Vec3::ONE.normalize();
+        let found = c.iter().zip(&n).flat_map(|(t, n)| t.iter().zip(n)).find(|(p, _)| **p == Vec3::ONE).unwrap();
+        assert!((*found.1 - corner).length() < 1e-5, "{:?}", found.1);
+    }
+
+    #[test]
+    fn similarities_are_told_from_stretches() {
+        let rot = DAffine3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7);
+        assert!((similarity(&(DAffine3::from_scale(DVec3::splat(2.5)) * rot)).unwrap() - 2.5).abs() < 1e-9);
+        assert!(similarity(&DAffine3::from_scale(DVec3::new(1.0, 2.0, 1.0))).is_none());
+    }
+}
