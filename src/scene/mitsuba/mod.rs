@@ -128,13 +128,15 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
                     el.tag, p.kind
                 )));
             }
-            t => return Err(xml::error(
-                &el.loc,
-                t,
-                format!(
+            t => {
+                return Err(xml::error(
+                    &el.loc,
+                    t,
+                    format!(
                     "<{t}> is not a scene element photonmap reads (shape, bsdf, emitter, sensor, integrator, texture)"
                 ),
-            )),
+                ))
+            }
         }
     }
     let Some((camera, spp, far, sensor)) = camera else {

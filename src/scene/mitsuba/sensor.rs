@@ -76,10 +76,12 @@ pub fn camera(p: &Plugin) -> Result<(Camera, u32, f64), SceneError> {
                 "box" => Filter::Box,
                 "tent" => Filter::Tent { radius: f.float_in("radius", 1.0, 1e-3, 64.0)? as f32 },
                 "gaussian" => Filter::Gaussian { stddev: f.float_in("stddev", 0.5, 1e-3, 16.0)? as f32 },
-                k => return Err(f.refuse(format!(
+                k => {
+                    return Err(f.refuse(format!(
                     "the '{k}' filter is not supported (box, tent and gaussian are: photonmap places samples by the \
                          filter's distribution, which needs a filter that is nowhere negative)"
-                ))),
+                )))
+                }
             };
             f.finish("radius (tent), stddev (gaussian)")?;
             filter

@@ -1,0 +1,365 @@
+//! The Mitsuba XML front-end on small scenes written here: each construct
+//! against what Mitsuba 3 defines it to be (transforms composed in the
+//! order written, includes and parameters, the perspective projection,
+//! spectra), each emitter and BSDF against a closed form, and every
+//! refusal at its file, line and column.
+
+mod common;
+
+use common::{photonmap, render_quiet, scratch_dir};
+use glam::{Vec2, Vec3};
+use photonmap::scene::mitsuba::{load, Imported, Options};
+use photonmap::scene::{Scene, SceneParts};
+use photonmap::settings::{Method, Settings};
+use photonmap::shape::Shape;
+use std::path::{Path, PathBuf};
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn read(path: &Path, defines: &[(&str, &str)]) -> Result<Imported, String> {
+    let options =
+        Options { defines: defines.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect(), substitute: false };
+    load(path, &options).map_err(|e| e.to_string())
+}
+
+/// A scene's sensor: 32x32, 90° across x, at the origin looking along +z
+/// with +y up, box filter, unless `sensor` replaces it.
+const SENSOR: &str = r#"<sensor type="perspective"><float name="fov" value="90"/>
+  <transform name="to_world"><lookat origin="0,0,0" target="0,0,1" up="0,1,0"/></transform>
+  <sampler type="independent"><integer name="sample_count" value="4"/></sampler>
+  <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/><rfilter type="box"/></film>
+</sensor>"#;
+
+fn scene(body: &str) -> String {
+    format!("<scene version=\"3.0.0\">\n{SENSOR}\n{body}\n</scene>\n")
+}
+
+fn triangles(parts: &SceneParts) -> Vec<[Vec3; 3]> {
+    parts
+        .prims
+        .iter()
+        .filter_map(|p| match p.shape {
+            Shape::Triangle(t) => Some([t.v0, t.v1, t.v2]),
+            _ => None,
+        })
+        .collect()
+}
+
+fn bounds(tris: &[[Vec3; 3]]) -> (Vec3, Vec3) {
+    let all = tris.iter().flatten();
+    (all.clone().fold(Vec3::INFINITY, |a, b| a.min(*b)), all.fold(Vec3::NEG_INFINITY, |a, b| a.max(*b)))
+}
+
+#[test]
+fn transforms_compose_in_the_order_written() {
+    let dir = scratch_dir("mitsuba_transforms");
+    let rect = |steps: &str| {
+        let f = write(
+            &dir,
+            "t.xml",
+            &scene(&format!(r#"<shape type="rectangle"><transform name="to_world">{steps}</transform></shape>"#)),
+        );
+        bounds(&triangles(&read(&f, &[]).unwrap().file.parts))
+    };
+    // Scale first, then move: the plane at z = 5, 4 wide.
+    let (lo, hi) = rect(r#"<scale value="2"/><translate z="5"/>"#);
+    assert!((lo - Vec3::new(-2.0, -2.0, 5.0)).length() < 1e-5 && (hi - Vec3::new(2.0, 2.0, 5.0)).length() < 1e-5);
+    // Move first, then scale: the move is scaled too.
+    let (lo, _) = rect(r#"<translate value="0 0 5"/><scale value="2"/>"#);
+    assert!((lo.z - 10.0).abs() < 1e-5, "{lo}");
+    // A rotation of 90° about x takes +y to +z; a row-major matrix is read by rows.
+    let (lo, hi) = rect(r#"<rotate x="1" angle="90"/>"#);
+    assert!(lo.y.abs() < 1e-5 && hi.y.abs() < 1e-5 && (hi.z - 1.0).abs() < 1e-5, "{lo} {hi}");
+    let (lo, _) = rect(r#"<matrix value="1 0 0 3  0 1 0 0  0 0 1 0  0 0 0 1"/>"#);
+    assert!((lo.x - 2.0).abs() < 1e-5, "{lo}");
+    // A mirroring scale keeps the front where it was by reversing the winding.
+    let f = write(
+        &dir,
+        "m.xml",
+        &scene(r#"<shape type="rectangle"><transform name="to_world"><scale x="-1"/></transform></shape>"#),
+    );
+    for p in &read(&f, &[]).unwrap().file.parts.prims {
+        let Shape::Triangle(t) = p.shape else { panic!() };
+        assert!((t.normal - Vec3::Z).length() < 1e-6, "{}", t.normal);
+    }
+}
+
+#[test]
+fn includes_defaults_and_parameters() {
+    let dir = scratch_dir("mitsuba_params");
+    write(
+        &dir,
+        "parts/ball.xml",
+        r#"<scene version="2.1.0"><shape type="sphere"><float name="radius" value="$r"/><point name="center" x="0" y="0" z="4"/></shape></scene>"#,
+    );
+    let main =
+        write(&dir, "main.xml", &scene(r#"<default name="r" value="0.5"/><include filename="parts/ball.xml"/>"#));
+    let radius = |d: &[(&str, &str)]| match read(&main, d).unwrap().file.parts.prims[0].shape {
+        Shape::Sphere(s) => s.radius,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(radius(&[]), 0.5);
+    assert_eq!(radius(&[("r", "2")]), 2.0, "-D wins over <default>");
+    // An undefined parameter is named, at the included file's line.
+    let bare = write(&dir, "bare.xml", &scene(r#"<include filename="parts/ball.xml"/>"#));
+    let e = read(&bare, &[]).unwrap_err();
+    assert!(e.contains("ball.xml:1:") && e.contains("$r"), "{e}");
+}
+
+/// Every mistake is refused at its place, naming what is supported.
+#[test]
+fn refusals_are_located() {
+    let dir = scratch_dir("mitsuba_refusals");
+    let cases: [(&str, &str, &str); 9] = [
+        ("unknown plugin", r#"<shape type="torus"/>"#, ":7:1: shape 'torus'"),
+        (
+            "unknown parameter",
+            r#"<shape type="rectangle"><bsdf type="diffuse"><float name="roughness" value="1"/></bsdf></shape>"#,
+            ":7:46: bsdf 'diffuse': 'roughness' is not supported",
+        ),
+        (
+            "wrong type",
+            r#"<shape type="sphere"><string name="radius" value="1"/></shape>"#,
+            "radius: must be a <float>",
+        ),
+        (
+            "unknown reference",
+            r#"<shape type="rectangle"><ref id="nowhere"/></shape>"#,
+            "no object has the id 'nowhere'",
+        ),
+        ("unsupported emitter", r#"<emitter type="envmap"/>"#, ":7:1: emitter 'envmap'"),
+        (
+            "bad number",
+            r#"<shape type="sphere"><float name="radius" value="one"/></shape>"#,
+            "'one' is not a finite number",
+        ),
+        (
+            "missing file",
+            r#"<shape type="obj"><string name="filename" value="no.obj"/></shape>"#,
+            "cannot find 'no.obj'",
+        ),
+        ("bad xml", "<shape type=\"sphere\">", "not well-formed XML"),
+        ("negative radius", r#"<shape type="sphere"><float name="radius" value="-1"/></shape>"#, "must be in [0,"),
+    ];
+    for (what, body, want) in cases {
+        let f = write(&dir, "s.xml", &scene(body));
+        let e = read(&f, &[]).err().unwrap_or_else(|| panic!("{what}: read"));
+        assert!(e.contains("s.xml:") && e.contains(want), "{what}: {e}");
+    }
+    let f = write(&dir, "v.xml", "<scene version=\"1.0\"/>");
+    assert!(read(&f, &[]).unwrap_err().contains("v.xml:1:1: scene.version"));
+    let f = write(&dir, "n.xml", "<scene version=\"3.0.0\"><shape type=\"sphere\"/></scene>");
+    assert!(read(&f, &[]).unwrap_err().contains("no <sensor>"));
+
+    // Through the program: exit 1, the message, and the output untouched.
+    let f = write(&dir, "bad.xml", &scene(r#"<shape type="torus"/>"#));
+    let out = dir.join("out.exr");
+    std::fs::write(&out, b"keep").unwrap();
+    let run = photonmap(&["--scene", f.to_str().unwrap(), out.to_str().unwrap()]);
+    assert_eq!(run.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("bad.xml:7:1"), "{}", String::from_utf8_lossy(&run.stderr));
+    assert_eq!(std::fs::read(&out).unwrap(), b"keep");
+}
+
+/// Mitsuba's perspective camera: +x of its frame is the image's left, the
+/// field of view spans the axis `fov_axis` names.
+#[test]
+fn the_camera_follows_mitsubas_projection() {
+    let dir = scratch_dir("mitsuba_camera");
+    let camera = |fov_axis: &str, w: u32, h: u32| {
+        let text = format!(
+            r#"<scene version="3.0.0"><sensor type="perspective"><float name="fov" value="90"/><string name="fov_axis" value="{fov_axis}"/>
+            <transform name="to_world"><lookat origin="1,2,3" target="1,2,4" up="0,1,0"/></transform>
+            <film type="hdrfilm"><integer name="width" value="{w}"/><integer name="height" value="{h}"/><rfilter type="box"/></film></sensor></scene>"#
+        );
+        read(&write(&dir, "c.xml", &text), &[]).unwrap().file.parts.camera
+    };
+    let c = camera("x", 64, 32);
+    assert_eq!((c.width, c.height), (64, 32));
+    // The left edge's middle is 45° to +x, the top edge's middle atan(1/2) up.
+    let left = c.ray(0, 16, Vec2::new(0.0, 0.0)).dir;
+    assert!((left - Vec3::new(1.0, 0.0, 1.0).normalize()).length() < 1e-5, "{left}");
+    assert!((c.ray(0, 0, Vec2::ZERO).origin - Vec3::new(1.0, 2.0, 3.0)).length() < 0.02, "near clip 0.01 only");
+    let top = c.ray(32, 0, Vec2::ZERO).dir;
+    assert!((top.y / top.z - 0.5).abs() < 1e-5, "{top}");
+    // fov_axis y: 90° top to bottom.
+    let c = camera("y", 64, 32);
+    let top = c.ray(32, 0, Vec2::ZERO).dir;
+    assert!((top.y / top.z - 1.0).abs() < 1e-5, "{top}");
+    // The default filter is Mitsuba's Gaussian.
+    let text = std::fs::read_to_string(dir.join("c.xml")).unwrap().replace("<rfilter type=\"box\"/>", "");
+    let c = read(&write(&dir, "g.xml", &text), &[]).unwrap().file.parts.camera;
+    assert_eq!(c.filter, photonmap::filter::Filter::Gaussian { stddev: 0.5 });
+}
+
+#[test]
+fn spectra_and_named_indices_convert_as_mitsuba_does() {
+    let dir = scratch_dir("mitsuba_spectra");
+    let f = write(
+        &dir,
+        "s.xml",
+        &scene(
+            r#"<shape type="rectangle"><bsdf type="diffuse"><spectrum name="reflectance" value="400:0.5, 500:0.5, 600:0.5, 700:0.5"/></bsdf></shape>
+               <shape type="sphere"><bsdf type="dielectric"><string name="int_ior" value="water"/></bsdf></shape>"#,
+        ),
+    );
+    let parts = read(&f, &[]).unwrap().file.parts;
+    let photonmap::material::Material::Lambertian { rho } = parts.materials[0] else { panic!() };
+    // A flat 0.5 over 400-700 nm under D65: grey, a little under 0.5 (the
+    // tails outside the given range count as zero).
+    assert!((rho.x - rho.y).abs() < 0.03 && (rho.z - rho.y).abs() < 0.03 && rho.y > 0.45 && rho.y <= 0.5, "{rho}");
+    let photonmap::material::Material::Glass { ior, .. } = parts.materials[1] else { panic!() };
+    assert!((ior - 1.333 / 1.000277).abs() < 1e-5, "{ior}");
+}
+
+/// A scene rendered by photon mapping, small.
+fn render(parts: SceneParts, spp: u32) -> photonmap::film::Film {
+    let scene = Scene::from_parts(parts);
+    let settings = Settings {
+        method: Method::Photon,
+        photons: 20_000,
+        caustic_photons: 20_000,
+        spp,
+        width: scene.camera.width,
+        height: scene.camera.height,
+        ..Settings::default()
+    };
+    render_quiet(&scene, &settings)
+}
+
+/// A camera 2 above a 20-wide plane (reflectance 0.6), looking down.
+fn plane_scene(plane_steps: &str, bsdf: &str, light: &str, integrator: &str) -> String {
+    format!(
+        r#"<scene version="3.0.0">
+  <integrator type="{integrator}"/>
+  <sensor type="perspective"><float name="fov" value="40"/>
+    <transform name="to_world"><lookat origin="0,0,2" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film>
+  </sensor>
+  <shape type="rectangle"><transform name="to_world"><scale value="10"/>{plane_steps}</transform>{bsdf}</shape>
+  {light}
+</scene>"#
+    )
+}
+
+const DIFFUSE: &str = r#"<bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf>"#;
+
+/// Directional light E on a Lambertian plane: L = rho E cos / pi, on the
+/// front only (Mitsuba's diffuse is one-sided; twosided reflects on both).
+#[test]
+fn a_directional_light_on_a_diffuse_plane_and_its_back() {
+    let dir = scratch_dir("mitsuba_directional");
+    let light = r#"<emitter type="directional"><vector name="direction" value="0,0,-1"/><rgb name="irradiance" value="2"/></emitter>"#;
+    let want = 0.6 * 2.0 / std::f64::consts::PI;
+    let f = write(&dir, "front.xml", &plane_scene("", DIFFUSE, light, "direct"));
+    let film = render(read(&f, &[]).unwrap().file.parts, 4);
+    assert!((film.mean() - want).abs() < 1e-4 * want, "{} vs {want}", film.mean());
+    // The plane turned over: the camera sees its back, black; a twosided
+    // BSDF reflects there as in front.
+    let turned = r#"<rotate x="1" angle="180"/>"#;
+    let f = write(&dir, "back.xml", &plane_scene(turned, DIFFUSE, light, "direct"));
+    assert_eq!(render(read(&f, &[]).unwrap().file.parts, 4).mean(), 0.0);
+    let two = format!(r#"<bsdf type="twosided">{DIFFUSE}</bsdf>"#);
+    let f = write(&dir, "two.xml", &plane_scene(turned, &two, light, "direct"));
+    let film = render(read(&f, &[]).unwrap().file.parts, 4);
+    assert!((film.mean() - want).abs() < 1e-4 * want, "{}", film.mean());
+}
+
+/// A point light I at height h: L = rho I / (pi h^2) below it; a spot
+/// light of the same intensity the same inside its beam, zero outside its
+/// cutoff, and linear in angle between.
+#[test]
+fn point_and_spot_lights_follow_their_falloff() {
+    let dir = scratch_dir("mitsuba_point_spot");
+    let centre = |film: &photonmap::film::Film| {
+        (film.get(7, 7).x + film.get(8, 7).x + film.get(7, 8).x + film.get(8, 8).x) as f64 / 4.0
+    };
+    let point =
+        r#"<emitter type="point"><point name="position" value="0,0,1"/><rgb name="intensity" value="3"/></emitter>"#;
+    let f = write(&dir, "point.xml", &plane_scene("", DIFFUSE, point, "direct"));
+    let film = render(read(&f, &[]).unwrap().file.parts, 16);
+    // rho I / pi * h / (h^2 + r^2)^(3/2) averaged over the four centre
+    // pixels' square on the plane (the plane is parallel to the image, so
+    // uniform on one is uniform on the other): 2 tan 20° / 8 a side.
+    let half = 2.0 * 20f64.to_radians().tan() / 8.0;
+    let n = 200;
+    let mut sum = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let (x, y) = ((i as f64 + 0.5) / n as f64 * 2.0 - 1.0, (j as f64 + 0.5) / n as f64 * 2.0 - 1.0);
+            let r2 = (x * half).powi(2) + (y * half).powi(2);
+            sum += (1.0 + r2).powf(-1.5);
+        }
+    }
+    let want = 0.6 * 3.0 / std::f64::consts::PI * sum / (n * n) as f64;
+    assert!((centre(&film) - want).abs() < 2e-3 * want, "{} vs {want}", centre(&film));
+    let spot = |cutoff: f64, beam: f64| {
+        format!(
+            r#"<emitter type="spot"><transform name="to_world"><lookat origin="0,0,1" target="0,0,0" up="0,1,0"/></transform>
+            <rgb name="intensity" value="3"/><float name="cutoff_angle" value="{cutoff}"/><float name="beam_width" value="{beam}"/></emitter>"#
+        )
+    };
+    let f = write(&dir, "spot.xml", &plane_scene("", DIFFUSE, &spot(30.0, 20.0), "direct"));
+    let film = render(read(&f, &[]).unwrap().file.parts, 16);
+    assert!((centre(&film) - want).abs() < 2e-3 * want, "spot beam: {}", centre(&film));
+    // The corners (≥ 24° off the axis seen from the light) lie beyond a 10° cutoff.
+    let f = write(&dir, "narrow.xml", &plane_scene("", DIFFUSE, &spot(10.0, 5.0), "direct"));
+    let film = render(read(&f, &[]).unwrap().file.parts, 16);
+    assert_eq!(film.get(0, 0), glam::Vec3::ZERO);
+    // Power: intensity over the falloff's solid angle.
+    let l =
+        photonmap::light::Spot::new(Vec3::ZERO, photonmap::math::Frame::from_normal(Vec3::Z), Vec3::ONE, 30.0, 20.0);
+    assert_eq!(l.falloff(1.0), 1.0);
+    assert!((l.falloff(25f32.to_radians().cos()) - 0.5).abs() < 1e-4);
+    assert_eq!(l.falloff(31f32.to_radians().cos()), 0.0);
+}
+
+/// Mitsuba's max_depth: 1 sees only lights, 2 adds direct light. A plane
+/// glowing with radiance 1 beside a lit diffuse floor.
+#[test]
+fn max_depth_limits_the_paths() {
+    let dir = scratch_dir("mitsuba_depth");
+    let light = r#"<emitter type="directional"><vector name="direction" value="0,0,-1"/><rgb name="irradiance" value="2"/></emitter>"#;
+    let with_depth = |d: i32| {
+        let text = plane_scene("", DIFFUSE, light, "path").replace(
+            "<integrator type=\"path\"/>",
+            &format!("<integrator type=\"path\"><integer name=\"max_depth\" value=\"{d}\"/></integrator>"),
+        );
+        read(&write(&dir, "d.xml", &text), &[]).unwrap()
+    };
+    assert_eq!(render(with_depth(1).file.parts, 4).mean(), 0.0, "a directional light is never seen");
+    let two = render(with_depth(2).file.parts, 4).mean();
+    assert!((two - 0.6 * 2.0 / std::f64::consts::PI).abs() < 1e-4, "{two}");
+    // Photon mapping cannot stop paths at 3 vertices: said, with the place.
+    let e = with_depth(3).photon_limit.expect("refused for photon mapping").to_string();
+    assert!(e.contains("d.xml:2:3") && e.contains("max_depth 3"), "{e}");
+}
+
+#[test]
+fn ply_meshes_and_instances() {
+    let dir = scratch_dir("mitsuba_ply");
+    write(
+        &dir,
+        "quad.ply",
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+         element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n",
+    );
+    let f = write(
+        &dir,
+        "i.xml",
+        &scene(
+            r#"<shape type="shapegroup" id="g"><shape type="ply"><string name="filename" value="quad.ply"/></shape></shape>
+               <shape type="instance"><ref id="g"/><transform name="to_world"><translate z="3"/></transform></shape>
+               <shape type="instance"><ref id="g"/><transform name="to_world"><translate z="5"/></transform></shape>"#,
+        ),
+    );
+    let tris = triangles(&read(&f, &[]).unwrap().file.parts);
+    assert_eq!(tris.len(), 4);
+    let (lo, hi) = bounds(&tris);
+    assert_eq!((lo.z, hi.z), (3.0, 5.0));
+}
