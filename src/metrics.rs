@@ -10,8 +10,10 @@
 //!   does; any other size mismatch is refused.
 //! * `rmse` = sqrt(mean((x - r)^2)) over pixels and the three channels;
 //!   `relmse` = mean((x - r)^2 / (r^2 + 0.01)); means of both images and the
-//!   relative bias of the test's. Non-finite test values are counted and
-//!   scored as 0.
+//!   relative bias of the test's (undefined where the reference's mean is
+//!   0). Non-finite test values are counted and scored as 0; a reference
+//!   holding a non-finite value is refused, with their count and the first
+//!   one's place (there is nothing to score against there).
 //! * A window is a rectangle of reference pixels scored the same way.
 //! * A speckle is a pixel of the full-size test image more than 4x brighter
 //!   (mean of its channels) than the median of its 5x5 neighbourhood, and
@@ -23,6 +25,9 @@
 use crate::film::Film;
 use crate::math::Color;
 use glam::DVec3;
+
+pub mod erfc;
+pub mod mitsuba_test;
 
 /// The default scene's caustic window in 200² pixel coordinates, rows
 /// 173..193 and columns 126..157: it frames the glass sphere's caustic on
@@ -95,13 +100,16 @@ pub struct Region {
 
 impl Region {
     /// The test's mean relative to the reference's, minus one (0 where the
-    /// reference's mean is 0).
+    /// reference's mean is 0: see [`Region::relative_bias`]).
     pub fn bias(&self) -> f64 {
-        if self.mean_ref != 0.0 {
-            self.mean_test / self.mean_ref - 1.0
-        } else {
-            0.0
-        }
+        self.relative_bias().unwrap_or(0.0)
+    }
+
+    /// The test's mean relative to the reference's, minus one; `None` where
+    /// the reference's mean is 0 (or not finite), where no relative figure
+    /// means anything.
+    pub fn relative_bias(&self) -> Option<f64> {
+        (self.mean_ref != 0.0 && self.mean_ref.is_finite()).then(|| self.mean_test / self.mean_ref - 1.0)
     }
 }
 
@@ -160,6 +168,22 @@ pub enum Mismatch {
     Size(u32, u32, u32, u32),
     #[error("window {name} ({r0}:{r1},{c0}:{c1}) lies outside the {w}x{h} reference")]
     Window { name: String, r0: u32, r1: u32, c0: u32, c1: u32, w: u32, h: u32 },
+    #[error(
+        "the reference holds {count} non-finite values (NaN or infinite; the first at column {col}, row {row}): a reference must be finite to score against"
+    )]
+    NonFiniteReference { count: u64, col: u32, row: u32 },
+}
+
+/// Refuses a reference holding a non-finite value.
+fn finite_reference(reference: &Film) -> Result<(), Mismatch> {
+    let mut bad = reference.pixels.iter().enumerate().filter(|(_, c)| !c.is_finite());
+    if let Some((first, _)) = bad.next() {
+        let count: u64 =
+            reference.pixels.iter().map(|c| c.to_array().iter().filter(|v| !v.is_finite()).count() as u64).sum();
+        let w = reference.width.max(1);
+        return Err(Mismatch::NonFiniteReference { count, col: first as u32 % w, row: first as u32 / w });
+    }
+    Ok(())
 }
 
 /// The integer factor by which `test` is larger than `reference` on both axes.
@@ -226,6 +250,7 @@ pub fn compare_images(test: &Film, reference: &Film, windows: &[Window]) -> Resu
     for w in windows {
         w.fits(reference.width, reference.height)?;
     }
+    finite_reference(reference)?;
     let (clean, nan_count) = finite(test);
     let reduced = box_down(&clean, factor);
     let mut whole = Sums::default();
@@ -261,6 +286,7 @@ pub fn compare_window(test: &Film, factor: u32, window: &Window, crop: &Film) ->
         return Err(Mismatch::Size(w, h, crop.width, crop.height));
     }
     window.fits(test.width / factor.max(1), test.height / factor.max(1))?;
+    finite_reference(crop)?;
     let (clean, _) = finite(test);
     let reduced = box_down(&clean, factor);
     let mut sums = Sums::default();
@@ -520,6 +546,33 @@ mod tests {
         let c = compare_images(&test, &reference, &[]).unwrap();
         assert_eq!(c.nan_count, 2);
         assert!((c.whole.rmse - (2.0f64 / 6.0).sqrt()).abs() < 1e-9);
+    }
+
+    /// A NaN or an infinity in the reference is refused with the count of
+    /// them and the first one's place (it once made every score NaN while
+    /// the count of non-finite values read 0).
+    #[test]
+    fn a_reference_holding_non_finite_values_is_refused() {
+        let test = film(3, 2, |_, _| Color::splat(0.5));
+        let mut reference = test.clone();
+        reference.pixels[4] = Color::new(f32::NAN, 0.5, f32::INFINITY);
+        reference.pixels[5] = Color::new(0.5, f32::NAN, 0.5);
+        let e = compare_images(&test, &reference, &[]).unwrap_err();
+        assert_eq!(e, Mismatch::NonFiniteReference { count: 3, col: 1, row: 1 });
+        assert!(e.to_string().contains("3 non-finite values"), "{e}");
+        let w = Window::parse("0:2,0:3", 0).unwrap();
+        assert!(matches!(compare_window(&test, 1, &w, &reference), Err(Mismatch::NonFiniteReference { .. })));
+    }
+
+    /// Against an all-zero reference the relative bias is undefined, not 0.
+    #[test]
+    fn the_relative_bias_against_a_black_reference_is_undefined() {
+        let reference = film(2, 2, |_, _| Color::ZERO);
+        let c = compare_images(&film(2, 2, |_, _| Color::splat(0.25)), &reference, &[]).unwrap();
+        assert_eq!(c.whole.relative_bias(), None);
+        assert!((c.whole.rmse - 0.25).abs() < 1e-9);
+        let c = compare_images(&film(2, 2, |_, _| Color::splat(0.75)), &film(2, 2, |_, _| Color::splat(0.5)), &[]);
+        assert!((c.unwrap().whole.relative_bias().unwrap() - 0.5).abs() < 1e-9);
     }
 
     /// Isolated bright pixels count; a bright region (a light, a caustic)

@@ -126,3 +126,46 @@ fn render_reference_and_compare_agree() {
     assert!(close(&rendered["caustic_rmse"], &v["windows"][0]["rmse"]), "{rendered} vs {v}");
     assert!(close(&rendered["mean_x"], &v["whole"]["mean_test"]));
 }
+
+/// A reference holding NaN or infinity is refused with their count and the
+/// first one's place; the scores once read NaN beside "non-finite values: 0".
+#[test]
+fn a_reference_with_non_finite_values_is_refused_with_their_count() {
+    let dir = scratch_dir("compare-nan-reference");
+    let test = exr(&dir, "test.exr", 6, 4, |_, _| 0.5);
+    let reference = exr(&dir, "ref.exr", 6, 4, |x, y| match (x, y) {
+        (2, 1) => f32::NAN,
+        (5, 3) => f32::INFINITY,
+        _ => 0.5,
+    });
+    for json in [false, true] {
+        let mut args = vec!["compare", test.as_str(), reference.as_str()];
+        if json {
+            args.push("--json");
+        }
+        let o = photonmap(&args);
+        let (out, err) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+        assert!(!o.status.success(), "accepted: {out}");
+        assert!(!out.contains("NaN") && !out.contains("non-finite values: 0"), "{out}");
+        // Grey pixels: three channels each.
+        assert!(err.contains("reference holds 6 non-finite values") && err.contains("column 2, row 1"), "{err}");
+    }
+}
+
+/// Against an all-black reference the relative bias is undefined: the
+/// table says so instead of "+0.00%", the JSON holds null; the absolute
+/// figures stay.
+#[test]
+fn the_bias_against_a_black_reference_is_undefined() {
+    let dir = scratch_dir("compare-black-reference");
+    let test = exr(&dir, "test.exr", 6, 4, |_, _| 0.25);
+    let reference = exr(&dir, "ref.exr", 6, 4, |_, _| 0.0);
+    let o = photonmap(&["compare", &test, &reference]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!out.contains("0.00%") && out.contains("undefined"), "{out}");
+    assert!(out.contains("0.250000"), "the RMSE is still printed: {out}");
+    let v = json(&photonmap(&["compare", &test, &reference, "--json"]));
+    assert!(v["whole"]["bias"].is_null(), "{v}");
+    assert!((v["whole"]["rmse"].as_f64().unwrap() - 0.25).abs() < 1e-6);
+}

@@ -1,5 +1,9 @@
 //! `photonmap compare TEST.exr REF.exr`: a render's error against a
-//! reference, with the metric of `photonmap::metrics`.
+//! reference, with the metric of `photonmap::metrics`; with
+//! `--mitsuba-test` and the reference's variance, Mitsuba 3's acceptance
+//! test instead (`mitsuba.rs`).
+
+mod mitsuba;
 
 use photonmap::error::Error;
 use photonmap::metrics::{compare_images, diff_rgb8, Comparison, Region, Window};
@@ -11,12 +15,30 @@ use std::path::PathBuf;
 /// optionally a signed difference picture. TEST is reduced to REF's size
 /// by averaging blocks when REF is an integer factor smaller.
 #[derive(clap::Args, Debug)]
-#[command(after_help = "Example: photonmap compare out.exr ref.exr --window caustic=173:193,126:157 --diff diff.png")]
+#[command(
+    after_help = "Examples: photonmap compare out.exr ref.exr --window caustic=173:193,126:157 --diff diff.png\n          photonmap compare --mitsuba-test out.exr scene_ref_rgb.exr scene_ref_rgb_var.exr --fail-map failing.png"
+)]
 pub struct Args {
     /// The image to score (EXR, linear radiance).
     test: PathBuf,
-    /// The reference (EXR), the test's size or an integer factor smaller.
+    /// The reference (EXR), the test's size or an integer factor smaller
+    /// (with --mitsuba-test: the test's size).
     reference: PathBuf,
+    /// With --mitsuba-test: the reference's per-pixel variance (EXR).
+    #[arg(requires = "mitsuba_test", value_name = "VARIANCE")]
+    variance: Option<PathBuf>,
+    /// Mitsuba 3's render-test acceptance (its tests/test_renders.py):
+    /// images in XYZ, variance floored at 1e-4, z = |TEST - REF| *
+    /// sqrt(spp / VARIANCE) with spp = 2,000,000 / pixels, a pixel channel
+    /// passing when its two-sided p-value exceeds the Sidak level 1 -
+    /// 0.99^(1/pixels), accepted when 99.75% pass and TEST is finite. Exit
+    /// status: 0 accepted, 1 rejected, 2 the test could not be run.
+    #[arg(long, requires = "variance", conflicts_with_all = ["windows", "diff", "diff_scale"])]
+    mitsuba_test: bool,
+    /// With --mitsuba-test: write a picture of the failing pixels (red) over
+    /// the dimmed test image (.png or .ppm).
+    #[arg(long, value_name = "OUT.png", requires = "mitsuba_test")]
+    fail_map: Option<PathBuf>,
     /// A rectangle of reference pixels scored on its own, as
     /// [NAME=]ROW0:ROW1,COL0:COL1 (half-open, row 0 at the top); repeatable.
     #[arg(long = "window", value_name = "[NAME=]R0:R1,C0:C1")]
@@ -42,6 +64,9 @@ fn parse_scale(s: &str) -> Result<f32, String> {
 }
 
 pub fn run(args: Args) -> Result<(), Error> {
+    if args.mitsuba_test {
+        mitsuba::run(&args);
+    }
     let windows: Vec<Window> = args
         .windows
         .iter()
@@ -84,7 +109,7 @@ fn region_json(r: &Region) -> serde_json::Value {
         "relmse": r.relmse,
         "mean_test": r.mean_test,
         "mean_ref": r.mean_ref,
-        "bias": r.bias(),
+        "bias": r.relative_bias(),
         "pixels": r.pixels,
     })
 }
@@ -121,21 +146,24 @@ fn table(c: &Comparison, args: &Args, diff_scale: Option<f32>) -> String {
     out +=
         &format!("{:<12} {:>10} {:>10} {:>10} {:>10} {:>8}\n", "region", "rmse", "relmse", "mean", "ref mean", "bias");
     let row = |name: &str, r: &Region| {
+        let bias = match r.relative_bias() {
+            Some(b) => format!("{:>+7.2}%", 100.0 * b),
+            None => "undefined".into(),
+        };
         format!(
-            "{:<12} {:>10.6} {:>10.6} {:>10.6} {:>10.6} {:>+7.2}%\n",
-            name,
-            r.rmse,
-            r.relmse,
-            r.mean_test,
-            r.mean_ref,
-            100.0 * r.bias()
+            "{:<12} {:>10.6} {:>10.6} {:>10.6} {:>10.6} {bias:>8}\n",
+            name, r.rmse, r.relmse, r.mean_test, r.mean_ref
         )
     };
     out += &row("whole", &c.whole);
     for (w, r) in &c.windows {
         out += &row(&w.name, r);
     }
-    out += &format!("speckles: {} pixels; non-finite values: {}\n", c.speckles, c.nan_count);
+    if std::iter::once(&c.whole).chain(c.windows.iter().map(|(_, r)| r)).any(|r| r.relative_bias().is_none()) {
+        out += "bias undefined: the reference's mean is 0 there, so no relative figure means anything\n";
+    }
+    let scored = if c.nan_count > 0 { " (scored as 0)" } else { "" };
+    out += &format!("speckles: {} pixels; non-finite values in the test: {}{scored}\n", c.speckles, c.nan_count);
     if let (Some(path), Some(s)) = (&args.diff, diff_scale) {
         out += &format!("difference picture: {} (full intensity at {s:.4})\n", path.display());
     }
