@@ -139,6 +139,15 @@ pub enum Light {
     },
     /// A point emitting `intensity` (W/sr) into a cone (Mitsuba's `spot`).
     Spot(Spot),
+    /// Radiance arriving equally from every direction at infinity
+    /// (Mitsuba's `constant`). Photons start on a disk facing their
+    /// direction that covers the scene's bounding sphere (`center`,
+    /// `radius`), outside it.
+    Constant {
+        radiance: Color,
+        center: Vertex,
+        radius: f32,
+    },
 }
 
 /// A spot light: intensity I along its axis out to `beam` (the half-angle
@@ -277,6 +286,12 @@ impl Light {
             Light::Directional { direction, irradiance, .. } => {
                 Some(Incident { dir: -direction, target: None, intensity: irradiance, prim: None })
             }
+            Light::Constant { radiance, .. } => {
+                // Uniform over the sphere (pdf 1 / 4π); `incident_around`
+                // samples the hemisphere a surface sees instead.
+                let dir = uniform_cone(u, -1.0).normalize();
+                Some(Incident { dir, target: None, intensity: radiance * (4.0 * PI), prim: None })
+            }
             Light::Spot(spot) => {
                 let to = spot.position - p;
                 let dist2 = to.length_squared();
@@ -295,6 +310,25 @@ impl Light {
         }
     }
 
+    /// As [`Self::incident`], for a surface at `p` whose reflecting side
+    /// faces unit `n`: light from everywhere is sampled by the cosine about
+    /// `n` (pdf cos / π), so that an unoccluded diffuse point's estimate has
+    /// no variance; every other light as `incident`.
+    #[inline]
+    pub fn incident_around(&self, p: Vertex, n: Vec3, u: Vec2) -> Option<Incident> {
+        match *self {
+            Light::Constant { radiance, .. } => {
+                let local = cosine_hemisphere(u);
+                if !(local.z > 0.0) {
+                    return None;
+                }
+                let dir = Frame::from_normal(n).to_world(local).normalize();
+                Some(Incident { dir, target: None, intensity: radiance * (PI / local.z), prim: None })
+            }
+            _ => self.incident(p, u),
+        }
+    }
+
     /// Total emitted power per channel.
     pub fn power(&self) -> Color {
         match *self {
@@ -302,6 +336,8 @@ impl Light {
             Light::Point { intensity, .. } => 4.0 * PI * intensity,
             Light::Directional { irradiance, reach, .. } => PI * reach.1 * reach.1 * irradiance,
             Light::Spot(s) => s.solid_angle * s.intensity,
+            // Through the disk πR², from every direction: L 4π πR².
+            Light::Constant { radiance, radius, .. } => radiance * (4.0 * PI * PI * radius * radius),
         }
     }
 
@@ -327,6 +363,15 @@ impl Light {
                 let frame = Frame::from_normal(direction);
                 let d = concentric_disk(u_pos) * reach.1;
                 (Ray::new(reach.0 + frame.s * d.x + frame.t * d.y, direction), None, 1.0)
+            }
+            Light::Constant { center, radius, .. } => {
+                // Travelling along a uniform direction, from a uniform
+                // point of the disk facing it beyond the bounding sphere.
+                let dir = uniform_cone(u_dir, -1.0).normalize();
+                let origin = center - dir * (2.0 * radius);
+                let frame = Frame::from_normal(dir);
+                let d = concentric_disk(u_pos) * radius;
+                (Ray::new(origin + frame.s * d.x + frame.t * d.y, dir), None, 1.0)
             }
             Light::Spot(s) => {
                 let local = uniform_cone(u_dir, s.cos_cutoff);

@@ -363,3 +363,49 @@ fn ply_meshes_and_instances() {
     let (lo, hi) = bounds(&tris);
     assert_eq!((lo.z, hi.z), (3.0, 5.0));
 }
+
+/// A furnace: a diffuse sphere of reflectance 0.5 inside a constant
+/// environment L = 2 reflects rho L = 1 at every point (it is convex: each
+/// point sees the whole sky above it), by photon mapping and by the path
+/// tracer; the sky is seen as L, or black with hide_emitters.
+#[test]
+fn a_diffuse_sphere_in_a_constant_environment() {
+    let dir = scratch_dir("mitsuba_constant");
+    let text = |integrator: &str| {
+        format!(
+            r#"<scene version="3.0.0">{integrator}
+  <sensor type="perspective"><float name="fov" value="60"/>
+    <transform name="to_world"><lookat origin="0,0,-3" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film>
+  </sensor>
+  <shape type="sphere"><bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape>
+  <emitter type="constant"><rgb name="radiance" value="2"/></emitter>
+</scene>"#
+        )
+    };
+    for method in [Method::Photon, Method::Path] {
+        let f = write(&dir, "c.xml", &text(""));
+        let scene = Scene::from_parts(read(&f, &[]).unwrap().file.parts);
+        let settings = Settings {
+            method,
+            photons: 20_000,
+            caustic_photons: 0,
+            spp: 16,
+            width: 16,
+            height: 16,
+            ..Settings::default()
+        };
+        let film = render_quiet(&scene, &settings);
+        let centre = film.get(8, 8);
+        assert!((centre - Vec3::ONE).abs().max_element() < 0.02, "{method:?}: sphere {centre}");
+        assert!((film.get(0, 0) - Vec3::splat(2.0)).abs().max_element() < 1e-6, "{method:?}: sky {}", film.get(0, 0));
+    }
+    let f = write(
+        &dir,
+        "h.xml",
+        &text(r#"<integrator type="path"><boolean name="hide_emitters" value="true"/></integrator>"#),
+    );
+    let film = render(read(&f, &[]).unwrap().file.parts, 4);
+    assert_eq!(film.get(0, 0), Vec3::ZERO);
+    assert!((film.get(8, 8) - Vec3::ONE).abs().max_element() < 0.02, "{}", film.get(8, 8));
+}

@@ -251,6 +251,14 @@ pub fn to_mitsuba(
                     rgb(irradiance)
                 );
             }
+            LightSpec::Constant { radiance } => {
+                emitters += &flush(&mut out, &mut tri_run);
+                let _ = write!(
+                    emitters,
+                    "    <emitter type=\"constant\">\n        <rgb name=\"radiance\" value=\"{}\"/>\n    </emitter>\n",
+                    rgb(radiance)
+                );
+            }
             LightSpec::Spot { position, axis, intensity, cutoff_deg, beam_deg } => {
                 emitters += &flush(&mut out, &mut tri_run);
                 let eye = at(position);

@@ -40,7 +40,7 @@ pub fn direct_light(
             for (j, slot) in pair.iter_mut().enumerate().take((count - s) as usize) {
                 let u = stratified_2d(s + j as u32, count, next_2d(ctx.rng));
                 *slot = light
-                    .incident(hit.point, u)
+                    .incident_around(hit.point, n, u)
                     .map(|inc| (n.dot(inc.dir), inc))
                     .filter(|&(c, inc)| c > 0.0 && reaches(hit, n, inc.dir));
             }
@@ -84,7 +84,7 @@ pub fn direct_light_one_at_a_time(
         let mut sum = Color::ZERO;
         for s in 0..count {
             let u = stratified_2d(s, count, next_2d(ctx.rng));
-            let Some(inc) = light.incident(hit.point, u) else { continue };
+            let Some(inc) = light.incident_around(hit.point, n, u) else { continue };
             let cos_x = n.dot(inc.dir);
             if cos_x > 0.0 && reaches(hit, n, inc.dir) && unshadowed(scene, hit, &inc, ctx) {
                 sum += brdf(inc.dir) * inc.intensity * cos_x;

@@ -48,15 +48,21 @@ impl Integrator for PathIntegrator<'_> {
                 break;
             }
             ctx.counters.rays += 1;
-            let Some(hit) = self.scene.intersect(&ray, departure) else { break };
-            throughput *= self.scene.transmittance(departure, hit.t);
-            let material = self.scene.material_seen(&hit, ray.dir);
             let wanted = match part {
                 Part::All => true,
                 Part::Emitted => specular_chain,
                 Part::Reflected => !specular_chain,
             };
             let hidden = depth == 0 && limits.hide_emitters;
+            let Some(hit) = self.scene.intersect(&ray, departure) else {
+                // Light from everywhere, where shadow rays did not count it.
+                if count_emission && wanted && !hidden {
+                    radiance += throughput * self.scene.background();
+                }
+                break;
+            };
+            throughput *= self.scene.transmittance(departure, hit.t);
+            let material = self.scene.material_seen(&hit, ray.dir);
             if count_emission && wanted && !hidden {
                 // A light's own surface, or a glowing one; after a diffuse
                 // bounce the shadow rays counted it.

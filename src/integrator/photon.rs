@@ -177,18 +177,19 @@ impl<'a> PhotonIntegrator<'a> {
         sh: &mut Shade<'_, '_, 'a>,
     ) -> Color {
         sh.ctx.counters.rays += 1;
+        // What the eye meets is the path's vertex depth + 1; a scene may
+        // limit how many there are (`PathLimits`).
+        let limits = self.scene.paths;
+        let within = |vertices: u32| limits.max_depth.is_none_or(|m| vertices <= m);
+        // Whether light leaving what the ray meets (a light's own surface, a
+        // glowing one, or light from everywhere) is counted.
+        let seen = part != Part::Reflected && within(depth + 1) && !(depth == 0 && limits.hide_emitters);
         let Some(hit) = self.scene.intersect(&ray, departure) else {
-            return Color::ZERO;
+            return if seen { self.scene.background() } else { Color::ZERO };
         };
         let through = self.scene.transmittance(departure, hit.t);
         let w = w * through;
         let material = self.scene.material_seen(&hit, ray.dir);
-        // This hit is the path's vertex depth + 1 after the eye; a scene
-        // may limit how many there are (`PathLimits`).
-        let limits = self.scene.paths;
-        let within = |vertices: u32| limits.max_depth.is_none_or(|m| vertices <= m);
-        // A light's own surface, or a glowing one.
-        let seen = part != Part::Reflected && within(depth + 1) && !(depth == 0 && limits.hide_emitters);
         let emitted = if seen { self.scene.emitted(hit.prim, ray.dir) } else { Color::ZERO };
         if material.is_emitter() {
             return through * emitted;

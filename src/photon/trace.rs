@@ -136,7 +136,17 @@ fn aim(
     scale: f32,
     rng: &mut Rng,
 ) -> Option<Emitted> {
-    if let Light::Directional { direction, irradiance, reach } = *light {
+    // Light from everywhere: a uniform direction (pdf 1 / 4π), then as a
+    // directional light of irradiance L 4π along it.
+    let parallel = match *light {
+        Light::Directional { direction, irradiance, reach } => Some((direction, irradiance, reach)),
+        Light::Constant { radiance, center, radius } => {
+            let direction = uniform_cone(next_2d(rng), -1.0).normalize();
+            Some((direction, radiance * (4.0 * PI), (center - direction * (2.0 * radius), radius)))
+        }
+        _ => None,
+    };
+    if let Some((direction, irradiance, reach)) = parallel {
         // Parallel light: start uniformly on the disk the chosen
         // object's bounding sphere casts on the emission plane; the
         // power is E / (pdf_A n), pdf_A the mixture over all disks.
@@ -165,7 +175,7 @@ fn aim(
         Light::Area(a) => (a.sample_point(next_2d(rng)).point, Some(Departure { prim: a.prim, outward: true })),
         Light::Point { position, .. } => (*position, None),
         Light::Spot(s) => (s.position, None),
-        Light::Directional { .. } => unreachable!("handled above"),
+        Light::Directional { .. } | Light::Constant { .. } => unreachable!("handled above"),
     };
     let (axis, cos_max) = chosen.cone_from(origin);
     // Unit to rounding without normalising (`Frame::to_world`).
@@ -201,7 +211,7 @@ fn aim(
         }
         Light::Point { intensity, .. } => *intensity,
         Light::Spot(s) => s.intensity_towards(dir.normalize()),
-        Light::Directional { .. } => unreachable!("handled above"),
+        Light::Directional { .. } | Light::Constant { .. } => unreachable!("handled above"),
     };
     Some((Ray::new(origin, dir), departure, intensity * scale / pdf_dir))
 }

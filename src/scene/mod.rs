@@ -171,6 +171,7 @@ pub struct Scene {
     /// (itself where two-sided); empty where every material is.
     back_material: Vec<u32>,
     pub paths: PathLimits,
+    background: Color,
 }
 
 /// Marks a primitive that is not a light's surface.
@@ -197,6 +198,10 @@ pub enum LightSpec {
     Directional {
         direction: Vec3,
         irradiance: Color,
+    },
+    /// Radiance from every direction at infinity (Mitsuba's `constant`).
+    Constant {
+        radiance: Color,
     },
     /// A cone of light from `position` along unit `axis` ([`crate::light::Spot`]).
     Spot {
@@ -264,7 +269,7 @@ impl SceneParts {
                     *position *= s;
                     *intensity *= s * s;
                 }
-                LightSpec::Directional { .. } => {}
+                LightSpec::Directional { .. } | LightSpec::Constant { .. } => {}
                 LightSpec::Spot { position, intensity, .. } => {
                     *position *= s;
                     *intensity *= s * s;
@@ -353,6 +358,9 @@ impl Scene {
                 LightSpec::Directional { direction, irradiance } => {
                     lights.push(Light::Directional { direction, irradiance, reach: (Vec3::ZERO, 0.0) });
                 }
+                LightSpec::Constant { radiance } => {
+                    lights.push(Light::Constant { radiance, center: Vec3::ZERO, radius: 0.0 });
+                }
                 LightSpec::Spot { position, axis, intensity, cutoff_deg, beam_deg } => {
                     lo = lo.min(position);
                     hi = hi.max(position);
@@ -366,10 +374,19 @@ impl Scene {
         }
         // Directional photons start outside everything else.
         for l in &mut lights {
-            if let Light::Directional { direction, reach, .. } = l {
-                *reach = directional_reach(*direction, lo, hi);
+            match l {
+                Light::Directional { direction, reach, .. } => *reach = directional_reach(*direction, lo, hi),
+                Light::Constant { center, radius, .. } => (*center, *radius) = directional_reach(Vec3::ZERO, lo, hi),
+                _ => {}
             }
         }
+        let background = lights
+            .iter()
+            .map(|l| match l {
+                Light::Constant { radiance, .. } => *radiance,
+                _ => Color::ZERO,
+            })
+            .sum();
         let targets = specular_targets(&prims, &materials);
         // Lights stay out of the enclosure: their hits must name them.
         let group: Vec<Option<u32>> =
@@ -391,7 +408,15 @@ impl Scene {
             light_pick,
             back_material,
             paths,
+            background,
         }
+    }
+
+    /// Radiance arriving along a ray that leaves the scene (light from
+    /// everywhere; black without it).
+    #[inline]
+    pub fn background(&self) -> Color {
+        self.background
     }
 
     #[inline]

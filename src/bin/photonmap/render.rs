@@ -361,6 +361,12 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
     if let Some(reference) = &reference {
         reduction_factor((width, height), (reference.width, reference.height))
             .map_err(|e| Error::Invalid(format!("--reference: {e}")))?;
+        let bad = reference.pixels.iter().filter(|c| !c.is_finite()).count();
+        if bad > 0 {
+            return Err(Error::Invalid(format!(
+                "--reference: {bad} pixels hold non-finite values; a reference must be finite to score against"
+            )));
+        }
     }
     for w in &windows {
         if w.rows.1 > height || w.cols.1 > width {

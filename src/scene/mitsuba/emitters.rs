@@ -68,13 +68,16 @@ fn light_of(p: &Plugin) -> Result<LightSpec, SceneError> {
             }
         }
         "area" => return Err(p.refuse("an area emitter must be nested in the <shape> that emits")),
-        "constant" | "envmap" => {
-            return Err(p.refuse(format!("the '{}' emitter (light from everywhere) is not supported yet", p.kind)))
+        "constant" => {
+            let radiance = p.color("radiance", Use::Emission)?.unwrap_or(Color::ONE);
+            p.finish("radiance")?;
+            LightSpec::Constant { radiance }
         }
+        "envmap" => return Err(p.refuse("the 'envmap' emitter is not supported yet ('constant' is)")),
         k => {
-            return Err(
-                p.refuse(format!("the '{k}' emitter is not supported yet (point, directional, spot and area are)"))
-            )
+            return Err(p.refuse(format!(
+                "the '{k}' emitter is not supported yet (point, directional, spot, constant and area are)"
+            )))
         }
     };
     if let LightSpec::Point { intensity: c, .. }
