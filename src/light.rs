@@ -148,6 +148,44 @@ pub enum Light {
         center: Vertex,
         radius: f32,
     },
+    /// A pinhole projecting irradiance through a frustum (Mitsuba's
+    /// `projector`).
+    Projector(Projector),
+}
+
+/// A projector at `position` shining along `axes[2]` through the frustum
+/// |x / z| <= tan_x, |y / z| <= tan_y of its frame, with the radiant
+/// intensity Mitsuba 3 gives it (src/emitters/projector.cpp): π E s / cos³θ,
+/// so that a plane at unit distance facing it receives the same light
+/// wherever the frustum reaches it.
+#[derive(Clone, Copy, Debug)]
+pub struct Projector {
+    pub position: Vertex,
+    /// The frame's x, y and z (the axis) in world space, unit.
+    pub axes: [Vec3; 3],
+    /// π times the irradiance times the scale.
+    pub scaled: Color,
+    pub tan_x: f32,
+    pub tan_y: f32,
+}
+
+impl Projector {
+    /// The direction from the projector to world direction `dir` in its
+    /// frame, if inside the frustum.
+    #[inline]
+    fn local(&self, dir: Vec3) -> Option<Vec3> {
+        let l = Vec3::new(dir.dot(self.axes[0]), dir.dot(self.axes[1]), dir.dot(self.axes[2]));
+        (l.z > 0.0 && l.x.abs() <= self.tan_x * l.z && l.y.abs() <= self.tan_y * l.z).then_some(l)
+    }
+
+    /// Radiant intensity towards unit world direction `dir`.
+    #[inline]
+    pub fn intensity_towards(&self, dir: Vec3) -> Color {
+        match self.local(dir) {
+            Some(l) => self.scaled / (l.z * l.z * l.z),
+            None => Color::ZERO,
+        }
+    }
 }
 
 /// A spot light: intensity I along its axis out to `beam` (the half-angle
@@ -292,6 +330,21 @@ impl Light {
                 let dir = uniform_cone(u, -1.0).normalize();
                 Some(Incident { dir, target: None, intensity: radiance * (4.0 * PI), prim: None })
             }
+            Light::Projector(pr) => {
+                let to = pr.position - p;
+                let dist2 = to.length_squared();
+                if !(dist2 > 0.0) {
+                    return None;
+                }
+                let dir = to / dist2.sqrt();
+                let intensity = pr.intensity_towards(-dir) / dist2;
+                (intensity.is_finite() && intensity.max_element() > 0.0).then_some(Incident {
+                    dir,
+                    target: Some(pr.position),
+                    intensity,
+                    prim: None,
+                })
+            }
             Light::Spot(spot) => {
                 let to = spot.position - p;
                 let dist2 = to.length_squared();
@@ -338,6 +391,8 @@ impl Light {
             Light::Spot(s) => s.solid_angle * s.intensity,
             // Through the disk πR², from every direction: L 4π πR².
             Light::Constant { radiance, radius, .. } => radiance * (4.0 * PI * PI * radius * radius),
+            // dω = cos³θ dA on the plane z = 1: the frustum's area there.
+            Light::Projector(p) => p.scaled * (4.0 * p.tan_x * p.tan_y),
         }
     }
 
@@ -372,6 +427,13 @@ impl Light {
                 let frame = Frame::from_normal(dir);
                 let d = concentric_disk(u_pos) * radius;
                 (Ray::new(origin + frame.s * d.x + frame.t * d.y, dir), None, 1.0)
+            }
+            Light::Projector(p) => {
+                // Uniform on the frustum's window at z = 1: in proportion to
+                // the intensity, as dω = cos³θ dA.
+                let (x, y) = ((2.0 * u_dir.x - 1.0) * p.tan_x, (2.0 * u_dir.y - 1.0) * p.tan_y);
+                let dir = (p.axes[0] * x + p.axes[1] * y + p.axes[2]).normalize();
+                (Ray::new(p.position, dir), None, 1.0)
             }
             Light::Spot(s) => {
                 let local = uniform_cone(u_dir, s.cos_cutoff);

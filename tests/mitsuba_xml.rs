@@ -409,3 +409,25 @@ fn a_diffuse_sphere_in_a_constant_environment() {
     assert_eq!(film.get(0, 0), Vec3::ZERO);
     assert!((film.get(8, 8) - Vec3::ONE).abs().max_element() < 0.02, "{}", film.get(8, 8));
 }
+
+/// A projector 1 above a plane, facing it: Mitsuba's intensity π E / cos³θ
+/// gives the plane the irradiance π E everywhere in the frustum, so a
+/// diffuse plane of reflectance 0.6 has radiance 0.6 E across the image
+/// (the camera sees ±0.73 of the ±1 the frustum lights).
+#[test]
+fn a_projector_lights_a_facing_plane_evenly() {
+    let dir = scratch_dir("mitsuba_projector");
+    let light = r#"<emitter type="projector"><float name="fov" value="90"/><rgb name="irradiance" value="0.5"/><float name="scale" value="2"/>
+        <transform name="to_world"><lookat origin="0,0,1" target="0,0,0" up="0,1,0"/></transform></emitter>"#;
+    let f = write(&dir, "p.xml", &plane_scene("", DIFFUSE, light, "direct"));
+    let film = render(read(&f, &[]).unwrap().file.parts, 4);
+    for c in &film.pixels {
+        assert!((c.x - 0.6).abs() < 1e-4, "{c}");
+    }
+    // A narrower frustum leaves the image's corners dark.
+    let narrow = light.replace("value=\"90\"", "value=\"30\"");
+    let f = write(&dir, "n.xml", &plane_scene("", DIFFUSE, &narrow, "direct"));
+    let film = render(read(&f, &[]).unwrap().file.parts, 4);
+    assert_eq!(film.get(0, 0), Vec3::ZERO);
+    assert!((film.get(8, 8).x - 0.6).abs() < 1e-4);
+}

@@ -251,6 +251,9 @@ pub fn to_mitsuba(
                     rgb(irradiance)
                 );
             }
+            LightSpec::Projector(_) => {
+                return Err(refuse(light_place(), "the projector's export to Mitsuba is not written yet".to_string()));
+            }
             LightSpec::Constant { radiance } => {
                 emitters += &flush(&mut out, &mut tri_run);
                 let _ = write!(

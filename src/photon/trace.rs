@@ -175,6 +175,7 @@ fn aim(
         Light::Area(a) => (a.sample_point(next_2d(rng)).point, Some(Departure { prim: a.prim, outward: true })),
         Light::Point { position, .. } => (*position, None),
         Light::Spot(s) => (s.position, None),
+        Light::Projector(p) => (p.position, None),
         Light::Directional { .. } | Light::Constant { .. } => unreachable!("handled above"),
     };
     let (axis, cos_max) = chosen.cone_from(origin);
@@ -211,6 +212,7 @@ fn aim(
         }
         Light::Point { intensity, .. } => *intensity,
         Light::Spot(s) => s.intensity_towards(dir.normalize()),
+        Light::Projector(p) => p.intensity_towards(dir.normalize()),
         Light::Directional { .. } | Light::Constant { .. } => unreachable!("handled above"),
     };
     Some((Ray::new(origin, dir), departure, intensity * scale / pdf_dir))

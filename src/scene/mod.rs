@@ -203,6 +203,8 @@ pub enum LightSpec {
     Constant {
         radiance: Color,
     },
+    /// A projector ([`crate::light::Projector`]).
+    Projector(crate::light::Projector),
     /// A cone of light from `position` along unit `axis` ([`crate::light::Spot`]).
     Spot {
         position: Vertex,
@@ -270,6 +272,10 @@ impl SceneParts {
                     *intensity *= s * s;
                 }
                 LightSpec::Directional { .. } | LightSpec::Constant { .. } => {}
+                LightSpec::Projector(p) => {
+                    p.position *= s;
+                    p.scaled *= s * s;
+                }
                 LightSpec::Spot { position, intensity, .. } => {
                     *position *= s;
                     *intensity *= s * s;
@@ -360,6 +366,11 @@ impl Scene {
                 }
                 LightSpec::Constant { radiance } => {
                     lights.push(Light::Constant { radiance, center: Vec3::ZERO, radius: 0.0 });
+                }
+                LightSpec::Projector(p) => {
+                    lo = lo.min(p.position);
+                    hi = hi.max(p.position);
+                    lights.push(Light::Projector(p));
                 }
                 LightSpec::Spot { position, axis, intensity, cutoff_deg, beam_deg } => {
                     lo = lo.min(position);

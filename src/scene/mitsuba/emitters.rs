@@ -67,6 +67,27 @@ fn light_of(p: &Plugin) -> Result<LightSpec, SceneError> {
                 beam_deg: beam.min(cutoff) as f32,
             }
         }
+        "projector" => {
+            let m = p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
+            let irradiance = p.color("irradiance", Use::Emission)?.unwrap_or(Color::ONE);
+            let scale = p.float_in("scale", 1.0, 0.0, 1e30)?;
+            // A constant irradiance is a 1 x 1 image: a square frustum.
+            let x_fov = super::sensor::fov(p, 1.0)?;
+            p.finish("to_world, irradiance, scale, fov, fov_axis")?;
+            let axes = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis];
+            let Some(axes) = axes.iter().map(|a| a.try_normalize().map(|a| a.as_vec3())).collect::<Option<Vec<_>>>()
+            else {
+                return Err(p.fail(p.loc(), "to_world", "is singular"));
+            };
+            let t = (0.5 * x_fov.to_radians()).tan() as f32;
+            LightSpec::Projector(crate::light::Projector {
+                position: m.translation.as_vec3(),
+                axes: [axes[0], axes[1], axes[2]],
+                scaled: irradiance * (std::f32::consts::PI * scale as f32),
+                tan_x: t,
+                tan_y: t,
+            })
+        }
         "area" => return Err(p.refuse("an area emitter must be nested in the <shape> that emits")),
         "constant" => {
             let radiance = p.color("radiance", Use::Emission)?.unwrap_or(Color::ONE);

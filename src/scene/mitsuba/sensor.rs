@@ -154,7 +154,7 @@ pub fn camera(p: &Plugin) -> Result<(Camera, u32, f64), SceneError> {
 }
 
 /// The horizontal field of view in degrees, from `fov` and `fov_axis`.
-fn fov(p: &Plugin, aspect: f64) -> Result<f64, SceneError> {
+pub(super) fn fov(p: &Plugin, aspect: f64) -> Result<f64, SceneError> {
     let fov = p.float("fov")?;
     let focal = p.string("focal_length")?;
     let (fov, axis) = match (fov, focal) {
