@@ -26,6 +26,7 @@ use std::f32::consts::{FRAC_1_PI, PI};
 /// random numbers are drawn and the terms summed in the same order as
 /// [`direct_light_one_at_a_time`], the plain version, so the two agree to
 /// the bit (tested below).
+#[allow(clippy::too_many_arguments)]
 pub fn direct_light(
     scene: &Scene,
     hit: &Hit,
@@ -74,6 +75,7 @@ pub fn direct_irradiance(scene: &Scene, x: Vec3, n: Vec3, count: u32, skip: bool
 }
 
 /// [`direct_light`] one sample at a time: the reference it must equal.
+#[allow(clippy::too_many_arguments)]
 pub fn direct_light_one_at_a_time(
     scene: &Scene,
     hit: &Hit,
