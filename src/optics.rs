@@ -38,9 +38,54 @@ pub fn fresnel_dielectric(cos_i: f32, n_i: f32, n_t: f32) -> f32 {
     0.5 * (rs * rs + rp * rp)
 }
 
+/// Unpolarised Fresnel reflectance of a conductor of complex index
+/// `eta` + i `k` (relative to the outside), per channel, for light arriving
+/// at `cos_i` in [0, 1]: the mean of the s- and p-polarised reflectances in
+/// the closed form of Moeller (Optics, 1988), which Mitsuba 3 uses
+/// (`fresnel_conductor`). eta = 0, k = 1 reflects everything.
+pub fn fresnel_conductor(cos_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
+    let c2 = (cos_i * cos_i).clamp(0.0, 1.0);
+    let s2 = 1.0 - c2;
+    let one = |eta: f32, k: f32| {
+        let t1 = eta * eta - k * k - s2;
+        let a2b2 = (t1 * t1 + 4.0 * eta * eta * k * k).max(0.0).sqrt();
+        let a = (0.5 * (a2b2 + t1)).max(0.0).sqrt();
+        let (t_1, t_2) = (a2b2 + c2, 2.0 * cos_i.clamp(0.0, 1.0) * a);
+        let rs = (t_1 - t_2) / (t_1 + t_2);
+        let (t_3, t_4) = (a2b2 * c2 + s2 * s2, t_2 * s2);
+        let rp = rs * (t_3 - t_4) / (t_3 + t_4);
+        let r = 0.5 * (rs + rp);
+        if r.is_finite() {
+            r.clamp(0.0, 1.0)
+        } else {
+            1.0
+        }
+    };
+    Vec3::new(one(eta.x, k.x), one(eta.y, k.y), one(eta.z, k.z))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A conductor of k = 0 is a dielectric; eta = 0, k = 1 a perfect
+    /// mirror; gold's normal reflectance is ((n-1)^2 + k^2) / ((n+1)^2 + k^2).
+    #[test]
+    fn conductor_fresnel_limits() {
+        for i in 0..=20 {
+            let c = i as f32 / 20.0;
+            let f = fresnel_conductor(c, Vec3::splat(1.5), Vec3::ZERO);
+            assert!(
+                (f.x - fresnel_dielectric(c, 1.0, 1.5)).abs() < 1e-5,
+                "{c}: {f} vs {}",
+                fresnel_dielectric(c, 1.0, 1.5)
+            );
+            assert!((fresnel_conductor(c, Vec3::ZERO, Vec3::ONE).x - 1.0).abs() < 1e-6);
+        }
+        let (n, k) = (0.18f32, 3.1f32);
+        let want = ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k);
+        assert!((fresnel_conductor(1.0, Vec3::splat(n), Vec3::splat(k)).x - want).abs() < 1e-5);
+    }
 
     #[test]
     fn normal_incidence_glass_reflects_four_percent() {

@@ -388,11 +388,14 @@ fn bsdf(m: &Material, id: &str) -> Result<String, String> {
                 .into())
         }
         Material::Emitter => format!("    <bsdf type=\"diffuse\" id=\"{id}\"><rgb name=\"reflectance\" value=\"0, 0, 0\"/></bsdf>\n"),
-        // A material added to photonmap renders before the export knows
-        // it: until an arm here says what it is in Mitsuba, exporting a
-        // scene that uses it is refused with its place.
-        #[allow(unreachable_patterns)]
-        _ => return Err("this material has no equivalent in the Mitsuba export yet; use lambertian, mirror or glass".into()),
+        // The materials with Mitsuba's own parameters; a material added to
+        // photonmap renders before the export knows it: until an arm says
+        // what it is in Mitsuba, exporting a scene that uses it is refused
+        // with its place.
+        _ => match super::mitsuba_bsdf::bsdf(m, id) {
+            Some(xml) => xml,
+            None => return Err("this material has no equivalent in the Mitsuba export yet".into()),
+        },
     })
 }
 

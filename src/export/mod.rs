@@ -2,4 +2,5 @@
 //! beside theirs on the same scene: Mitsuba 3 ([`mitsuba`]).
 
 pub mod mitsuba;
+mod mitsuba_bsdf;
 mod ply;

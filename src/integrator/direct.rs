@@ -15,7 +15,9 @@ use std::f32::consts::{FRAC_1_PI, PI};
 /// unit `w` (towards the light); `n` is the normal on the viewer's side.
 /// With `skip`, a light whose emitting side faces away from the point (a
 /// one-sided area light seen from behind or edge-on, where every sample has
-/// cos_l <= 0) is not sampled.
+/// cos_l <= 0) is not sampled. With `both_sides` (a surface that lets
+/// light through, rough glass), lights behind the surface count too, by
+/// |cos|.
 ///
 /// The samples are taken two at a time: both are drawn before either
 /// shadow ray is cast, so the processor works out the second (a chain of a
@@ -24,6 +26,7 @@ use std::f32::consts::{FRAC_1_PI, PI};
 /// random numbers are drawn and the terms summed in the same order as
 /// [`direct_light_one_at_a_time`], the plain version, so the two agree to
 /// the bit (tested below).
+#[allow(clippy::too_many_arguments)]
 pub fn direct_light(
     scene: &Scene,
     hit: &Hit,
@@ -31,6 +34,7 @@ pub fn direct_light(
     brdf: impl Fn(Vec3) -> Color,
     count: u32,
     skip: bool,
+    both_sides: bool,
     ctx: &mut Context,
 ) -> Color {
     each_light(scene, hit, count, skip, ctx, |light, count, ctx| {
@@ -42,11 +46,11 @@ pub fn direct_light(
                 *slot = light
                     .incident_around(hit.point, n, u)
                     .map(|inc| (n.dot(inc.dir), inc))
-                    .filter(|&(c, inc)| c > 0.0 && reaches(hit, n, inc.dir));
+                    .filter(|&(c, inc)| facing(c, both_sides) && reaches(hit, n, inc.dir, c > 0.0));
             }
             for (cos_x, inc) in pair.into_iter().flatten() {
                 if unshadowed(scene, hit, &inc, ctx) {
-                    sum += brdf(inc.dir) * inc.intensity * cos_x;
+                    sum += brdf(inc.dir) * inc.intensity * cos_x.abs();
                 }
             }
         }
@@ -67,10 +71,11 @@ pub fn direct_irradiance(scene: &Scene, x: Vec3, n: Vec3, count: u32, skip: bool
         return Color::ZERO;
     }
     let brdf = |_: Vec3| Color::splat(FRAC_1_PI);
-    PI * direct_light(scene, &hit, n, brdf, count, skip, ctx)
+    PI * direct_light(scene, &hit, n, brdf, count, skip, false, ctx)
 }
 
 /// [`direct_light`] one sample at a time: the reference it must equal.
+#[allow(clippy::too_many_arguments)]
 pub fn direct_light_one_at_a_time(
     scene: &Scene,
     hit: &Hit,
@@ -78,6 +83,7 @@ pub fn direct_light_one_at_a_time(
     brdf: impl Fn(Vec3) -> Color,
     count: u32,
     skip: bool,
+    both_sides: bool,
     ctx: &mut Context,
 ) -> Color {
     each_light(scene, hit, count, skip, ctx, |light, count, ctx| {
@@ -86,8 +92,8 @@ pub fn direct_light_one_at_a_time(
             let u = stratified_2d(s, count, next_2d(ctx.rng));
             let Some(inc) = light.incident_around(hit.point, n, u) else { continue };
             let cos_x = n.dot(inc.dir);
-            if cos_x > 0.0 && reaches(hit, n, inc.dir) && unshadowed(scene, hit, &inc, ctx) {
-                sum += brdf(inc.dir) * inc.intensity * cos_x;
+            if facing(cos_x, both_sides) && reaches(hit, n, inc.dir, cos_x > 0.0) && unshadowed(scene, hit, &inc, ctx) {
+                sum += brdf(inc.dir) * inc.intensity * cos_x.abs();
             }
         }
         sum
@@ -116,12 +122,20 @@ fn each_light(
     sum
 }
 
-/// Whether light from `dir` can reach the surface's side `n` faces: above
-/// the shading normal is not enough where it differs from the geometric
-/// one (light from below the actual surface would leak through it).
+/// Whether light from a direction of cosine `cos` with the normal counts:
+/// from above, or from either side where the surface lets light through.
+#[inline(always)]
+fn facing(cos: f32, both_sides: bool) -> bool {
+    cos > 0.0 || (both_sides && cos < 0.0)
+}
+
+/// Whether light from `dir` can reach the surface's side `n` faces (or,
+/// `above` false, its other side): the side of the shading normal is not
+/// enough where it differs from the geometric one (light from the far
+/// side of the actual surface would leak through it).
 #[inline]
-fn reaches(hit: &Hit, n: Vec3, dir: Vec3) -> bool {
-    hit.shading_normal == hit.normal || hit.leaves_as(-n, dir, true)
+fn reaches(hit: &Hit, n: Vec3, dir: Vec3, above: bool) -> bool {
+    hit.shading_normal == hit.normal || hit.leaves_as(-n, dir, above)
 }
 
 /// Casts the shadow ray from `hit` towards a light sample: whether nothing
@@ -159,8 +173,8 @@ mod tests {
                 let (mut r, mut counters) = (stream(9, Domain::Camera, i), Counters::default());
                 f(&mut Context { rng: &mut r, counters: &mut counters, pixel: i })
             };
-            let a = run(&|ctx| direct_light(&scene, &hit, n, brdf, count, true, ctx));
-            let b = run(&|ctx| direct_light_one_at_a_time(&scene, &hit, n, brdf, count, true, ctx));
+            let a = run(&|ctx| direct_light(&scene, &hit, n, brdf, count, true, false, ctx));
+            let b = run(&|ctx| direct_light_one_at_a_time(&scene, &hit, n, brdf, count, true, false, ctx));
             assert_eq!(a.to_array().map(f32::to_bits), b.to_array().map(f32::to_bits), "point {i}");
             checked += (a != Color::ZERO) as u32;
         }

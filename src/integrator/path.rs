@@ -81,9 +81,10 @@ impl Integrator for PathIntegrator<'_> {
                 };
                 Scatter { wi: b.wi, weight: b.scale, lobe: Lobe::Specular }
             } else {
-                if (material.diffuse_rho().is_some() || material.glossy().is_some()) && within(depth + 2) {
-                    let brdf = |w| material.eval(wo, frame.to_local(w));
-                    let direct = direct_light(self.scene, &hit, n, brdf, self.shadow_rays, self.skip, ctx);
+                if material.has_smooth_lobes() && within(depth + 2) {
+                    let brdf = |w| material.eval(wo, frame.to_local(w), entering, Transport::Radiance);
+                    let both = material.transmits();
+                    let direct = direct_light(self.scene, &hit, n, brdf, self.shadow_rays, self.skip, both, ctx);
                     radiance += throughput * ctx.checked(direct, "path direct");
                 }
                 let Some(s) = material.sample(wo, entering, Transport::Radiance, ctx.rng) else { break };

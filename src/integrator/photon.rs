@@ -201,9 +201,8 @@ impl<'a> PhotonIntegrator<'a> {
         if !branches.is_empty() && within(depth + 2) {
             radiance = self.specular(&hit, &frame, &branches, depth, part, w, sh) + radiance;
         }
-        let reflects = material.diffuse_rho().is_some() || material.glossy().is_some();
-        if part != Part::Emitted && reflects && within(depth + 2) {
-            radiance += self.surface(&hit, material, &frame, wo, w, sh);
+        if part != Part::Emitted && material.has_smooth_lobes() && within(depth + 2) {
+            radiance += self.surface(&hit, material, &frame, wo, entering, w, sh);
         }
         through * radiance
     }
@@ -239,19 +238,24 @@ impl<'a> PhotonIntegrator<'a> {
 
     /// Light reflected by a surface's smooth lobes: its diffuse lobe by
     /// direct light, the caustic map and final gathering; its glossy lobe
-    /// by direct light and one gather ray.
+    /// by direct light and one gather ray (through the surface, for rough
+    /// glass).
+    #[allow(clippy::too_many_arguments)]
     fn surface(
         &self,
         hit: &Hit,
         material: &Material,
         frame: &Frame,
         wo: glam::Vec3,
+        entering: bool,
         w: Color,
         sh: &mut Shade<'_, '_, 'a>,
     ) -> Color {
         let n = frame.n;
-        let brdf = |w: glam::Vec3| material.eval(wo, frame.to_local(w));
-        let direct = direct_light(self.scene, hit, n, brdf, self.settings.shadow_rays, self.settings.skip, sh.ctx);
+        let brdf = |w: glam::Vec3| material.eval(wo, frame.to_local(w), entering, Transport::Radiance);
+        let s = &self.settings;
+        let both = material.transmits();
+        let direct = direct_light(self.scene, hit, n, brdf, s.shadow_rays, s.skip, both, sh.ctx);
         let (mut caustic, mut indirect) = (Color::ZERO, Color::ZERO);
         // Longer paths are the maps' and gathering's; a scene that limits
         // paths to two vertices has only direct light here (a limit of
@@ -259,15 +263,16 @@ impl<'a> PhotonIntegrator<'a> {
         if self.scene.paths.max_depth.is_some() {
             return self.checked(direct, "direct", sh);
         }
-        if let Some(rho) = material.diffuse_rho() {
+        if material.diffuse_rho().is_some() {
+            let rho = material.diffuse_albedo(wo);
             caustic = self.caustic(hit, n, rho, sh);
             indirect = self.indirect(hit, n, rho, w, sh);
         }
-        if let Some(p) = material.glossy() {
+        if let Some(g) = material.glossy() {
             // One gather ray from the glossy lobe: indirect light it reflects.
-            if let Some((wi, weight)) = p.sample_glossy(wo, next_2d(sh.ctx.rng)) {
+            if let Some((wi, weight)) = g.sample(wo, entering, Transport::Radiance, sh.ctx.rng) {
                 let dir = frame.to_world(wi).normalize();
-                if hit.leaves_as(-frame.n, dir, true) {
+                if hit.leaves_as(-frame.n, dir, wi.z > 0.0) {
                     let (next, dep) = hit.spawn(dir);
                     indirect += weight * self.gather(next, dep, Lobe::Glossy, w * weight, sh);
                 }
@@ -368,6 +373,11 @@ impl<'a> PhotonIntegrator<'a> {
     /// or glass counts only where the last non-specular vertex was glossy:
     /// a diffuse one's is the caustic map's, and light met straight from a
     /// non-specular vertex is its direct estimate's (notes/method.md).
+    ///
+    /// A glossy lobe that carries caustics ([`crate::material::Glossy`])
+    /// stands for a specular one while the path is still a diffuse
+    /// vertex's (`from` diffuse): the light it brings is the caustic map's,
+    /// so it takes no shadow rays and is passed through like glass.
     fn gather(&self, mut ray: Ray, mut dep: Departure, mut from: Lobe, w: Color, sh: &mut Shade<'_, '_, 'a>) -> Color {
         let mut weight = Color::ONE;
         // A mirror or glass vertex since the last non-specular one.
@@ -387,15 +397,18 @@ impl<'a> PhotonIntegrator<'a> {
                 break;
             }
             let (frame, entering) = y.scattering_frame(ray.dir, material);
-            if let Some(rho_y) = material.diffuse_rho() {
-                found += self.read(y.point, frame.n, weight * rho_y / PI, w, sh);
-            }
             let wo = frame.to_local(-ray.dir);
+            if material.diffuse_rho().is_some() {
+                found += self.read(y.point, frame.n, weight * material.diffuse_albedo(wo) / PI, w, sh);
+            }
             let glossy = material.glossy();
-            if let Some(p) = glossy {
-                let brdf = |l: glam::Vec3| p.glossy(wo, frame.to_local(l));
+            // Whether the glossy lobe here is passed like glass.
+            let caustic_glossy = from == Lobe::Diffuse && glossy.is_some_and(|g| g.carries_caustics());
+            if let Some(g) = glossy.filter(|_| !caustic_glossy) {
+                let brdf = |l: glam::Vec3| g.eval(wo, frame.to_local(l), entering, Transport::Radiance);
                 let s = &self.settings;
-                found += weight * direct_light(self.scene, &y, frame.n, brdf, s.shadow_rays, s.skip, sh.ctx);
+                let both = g.transmits();
+                found += weight * direct_light(self.scene, &y, frame.n, brdf, s.shadow_rays, s.skip, both, sh.ctx);
             }
             // On through one of the lobes that are not read here: a specular
             // branch or the glossy lobe, chosen by what each reflects.
@@ -403,10 +416,7 @@ impl<'a> PhotonIntegrator<'a> {
             let p_specular = match glossy {
                 None => 1.0,
                 Some(_) if branches.is_empty() => 0.0,
-                Some(p) => {
-                    let [_, g, m] = p.lobe_weights();
-                    m / (g + m)
-                }
+                Some(g) => g.specular_share(),
             };
             let next_dir = if p_specular >= 1.0 || (p_specular > 0.0 && sh.ctx.rng.random::<f32>() < p_specular) {
                 let Some(b) = branches.choose(sh.ctx.rng) else { break };
@@ -414,9 +424,16 @@ impl<'a> PhotonIntegrator<'a> {
                 specular = true;
                 frame.to_world(b.wi).normalize()
             } else {
-                let Some((wi, gw)) = glossy.and_then(|p| p.sample_glossy(wo, next_2d(sh.ctx.rng))) else { break };
+                let Some((wi, gw)) = glossy.and_then(|g| g.sample(wo, entering, Transport::Radiance, sh.ctx.rng))
+                else {
+                    break;
+                };
                 weight *= gw / (1.0 - p_specular);
-                (from, specular) = (Lobe::Glossy, false);
+                if caustic_glossy {
+                    specular = true;
+                } else {
+                    (from, specular) = (Lobe::Glossy, false);
+                }
                 frame.to_world(wi).normalize()
             };
             if y.shading_normal != y.normal && !y.leaves_as(ray.dir, next_dir, frame.to_local(next_dir).z > 0.0) {

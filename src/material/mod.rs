@@ -6,20 +6,51 @@
 //!
 //! A material has up to three kinds of lobe, each owned by one estimator of
 //! photon mapping (notes/method.md):
-//! * **diffuse** (Lambertian): where photons are stored and density
-//!   estimates read ([`Material::diffuse_rho`]);
-//! * **glossy** (Phong's lobe): sampled like a path tracer;
-//! * **specular** (mirror, glass, Phong's mirror): perfect reflection and
-//!   refraction, followed by rays ([`Material::specular_branches`]).
+//! * **diffuse** (Lambertian, a plastic's base): where photons are stored
+//!   and density estimates read ([`Material::diffuse_rho`],
+//!   [`Material::diffuse_albedo`]);
+//! * **glossy** (Phong's lobe, rough metal and glass, a rough plastic's
+//!   coat): sampled like a path tracer ([`Material::glossy`], [`Glossy`]);
+//! * **specular** (mirror, glass, smooth metal, thin glass, Phong's mirror,
+//!   a smooth plastic's coat): perfect reflection and refraction, followed
+//!   by rays ([`Material::specular_branches`]).
 //!
 //! [`Material::eval`] and [`Material::pdf`] cover the smooth lobes (diffuse
 //! and glossy); [`Material::sample`] picks any lobe. Adding a material is a
 //! variant here and its answers to these questions, and its fields in the
 //! scene file (notes/architecture.md).
+//!
+//! Mitsuba 3's BSDFs map onto constructors with its parameter names and
+//! meanings (colours as RGB, named materials and indices converted by the
+//! front-end):
+//!
+//! | Mitsuba | constructor |
+//! |---|---|
+//! | `conductor` | [`Material::conductor`]`(eta, k, specular_reflectance)` |
+//! | `roughconductor` | [`Material::rough_conductor`]`(distribution, alpha_u, alpha_v, eta, k, specular_reflectance)` |
+//! | `roughdielectric` | [`Material::rough_dielectric`]`(distribution, alpha_u, alpha_v, int_ior, ext_ior, specular_reflectance, specular_transmittance)` |
+//! | `thindielectric` | [`Material::thin_dielectric`]`(int_ior, ext_ior, specular_reflectance, specular_transmittance)` |
+//! | `plastic` | [`Material::plastic`]`(diffuse_reflectance, specular_reflectance, int_ior, ext_ior, nonlinear)` |
+//! | `roughplastic` | [`Material::rough_plastic`]`(distribution, alpha, diffuse_reflectance, specular_reflectance, int_ior, ext_ior, nonlinear)` |
+//!
+//! Isotropic roughness is `alpha_u = alpha_v = alpha`; anisotropic alpha_u
+//! runs along the first tangent of the shading frame (`math::Frame`, built
+//! from the normal: meshes carry no texture-space tangents yet). Mitsuba's
+//! defaults are in [`defaults`].
 
+mod conductor;
+mod dielectric;
+mod glossy;
+pub mod microfacet;
 mod phong;
+mod plastic;
 
+pub use conductor::{Conductor, RoughConductor};
+pub use dielectric::{RoughDielectric, ThinDielectric};
+pub use glossy::{Glossy, CAUSTIC_ROUGHNESS};
+pub use microfacet::{Distribution, Microfacet};
 pub use phong::Phong;
+pub use plastic::{fresnel_diffuse_reflectance, Plastic, RoughPlastic};
 
 use crate::math::{max_component, Color};
 use crate::optics::{fresnel_dielectric, reflect, refract};
@@ -27,6 +58,25 @@ use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, next_2d, Rng};
 use glam::Vec3;
 use rand::RngExt;
 use std::f32::consts::PI;
+
+/// Mitsuba 3's defaults for the parameters of its BSDFs.
+pub mod defaults {
+    use super::microfacet::Distribution;
+    /// `distribution` of roughconductor, roughdielectric, roughplastic.
+    pub const DISTRIBUTION: Distribution = Distribution::Beckmann;
+    /// `alpha` of the rough BSDFs.
+    pub const ALPHA: f32 = 0.1;
+    /// `int_ior` of the dielectrics ("bk7") and of the plastics ("polypropylene").
+    pub const DIELECTRIC_INT_IOR: f32 = super::dielectric::BK7;
+    pub const PLASTIC_INT_IOR: f32 = super::plastic::POLYPROPYLENE;
+    /// `ext_ior` ("air").
+    pub const EXT_IOR: f32 = super::dielectric::AIR;
+    /// A conductor's `eta` and `k` with no named material: a perfect mirror.
+    pub const CONDUCTOR_ETA: f32 = 0.0;
+    pub const CONDUCTOR_K: f32 = 1.0;
+    /// A plastic's `diffuse_reflectance`.
+    pub const DIFFUSE_REFLECTANCE: f32 = 0.5;
+}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Material {
@@ -41,6 +91,18 @@ pub enum Material {
     Glass { ior: f32, absorption: Color },
     /// The Whitted course's material (see [`Phong`]).
     Phong(Phong),
+    /// Smooth metal: a mirror of Fresnel's complex-index reflectance.
+    Conductor(Conductor),
+    /// Rough metal: a microfacet lobe.
+    RoughConductor(RoughConductor),
+    /// Rough glass: microfacet reflection and transmission.
+    RoughDielectric(RoughDielectric),
+    /// A thin pane: reflection and straight transmission.
+    ThinDielectric(ThinDielectric),
+    /// A diffuse base under a smooth dielectric coat.
+    Plastic(Plastic),
+    /// A diffuse base under a rough dielectric coat.
+    RoughPlastic(RoughPlastic),
     /// A light's own surface: it emits (through its light) and reflects nothing.
     Emitter,
 }
@@ -123,43 +185,163 @@ impl Material {
         Material::Glass { ior, absorption: Color::ZERO }
     }
 
+    /// Mitsuba's `conductor`: complex index `eta` + i `k` per channel,
+    /// times `specular` (its specular_reflectance).
+    pub fn conductor(eta: Color, k: Color, specular: Color) -> Self {
+        Material::Conductor(Conductor { eta, k, specular })
+    }
+
+    /// Mitsuba's `roughconductor` (alpha below 1e-4 is raised to it).
+    pub fn rough_conductor(
+        distribution: Distribution,
+        alpha_u: f32,
+        alpha_v: f32,
+        eta: Color,
+        k: Color,
+        specular: Color,
+    ) -> Self {
+        let microfacet = Microfacet::new(distribution, alpha_u, alpha_v);
+        Material::RoughConductor(RoughConductor { microfacet, eta, k, specular })
+    }
+
+    /// Mitsuba's `roughdielectric`: `int_ior` inside (the side the
+    /// geometric normal points away from), `ext_ior` outside; they must
+    /// differ and be positive (the scene readers check).
+    pub fn rough_dielectric(
+        distribution: Distribution,
+        alpha_u: f32,
+        alpha_v: f32,
+        int_ior: f32,
+        ext_ior: f32,
+        specular_reflectance: Color,
+        specular_transmittance: Color,
+    ) -> Self {
+        let microfacet = Microfacet::new(distribution, alpha_u, alpha_v);
+        Material::RoughDielectric(RoughDielectric {
+            microfacet,
+            int_ior,
+            ext_ior,
+            specular_reflectance,
+            specular_transmittance,
+        })
+    }
+
+    /// Mitsuba's `thindielectric`.
+    pub fn thin_dielectric(
+        int_ior: f32,
+        ext_ior: f32,
+        specular_reflectance: Color,
+        specular_transmittance: Color,
+    ) -> Self {
+        Material::ThinDielectric(ThinDielectric { int_ior, ext_ior, specular_reflectance, specular_transmittance })
+    }
+
+    /// Mitsuba's `plastic`.
+    pub fn plastic(diffuse: Color, specular: Color, int_ior: f32, ext_ior: f32, nonlinear: bool) -> Self {
+        Material::Plastic(Plastic { diffuse, specular, eta: int_ior / ext_ior, nonlinear })
+    }
+
+    /// Mitsuba's `roughplastic` (isotropic, as Mitsuba's). The coat's
+    /// tables are computed on the first use of a (distribution, alpha,
+    /// index) and shared.
+    #[allow(clippy::too_many_arguments)]
+    pub fn rough_plastic(
+        distribution: Distribution,
+        alpha: f32,
+        diffuse: Color,
+        specular: Color,
+        int_ior: f32,
+        ext_ior: f32,
+        nonlinear: bool,
+    ) -> Self {
+        let microfacet = Microfacet::isotropic(distribution, alpha);
+        Material::RoughPlastic(RoughPlastic::new(microfacet, diffuse, specular, int_ior / ext_ior, nonlinear))
+    }
+
     pub fn is_emitter(&self) -> bool {
         matches!(self, Material::Emitter)
     }
 
-    /// Mirror and glass: all light leaving them is found by following rays,
-    /// never by density estimation.
+    /// Mirror, glass, smooth metal and thin glass: all light leaving them
+    /// is found by following rays, never by density estimation.
     pub fn is_specular(&self) -> bool {
-        matches!(self, Material::Mirror { .. } | Material::Glass { .. })
+        matches!(
+            self,
+            Material::Mirror { .. } | Material::Glass { .. } | Material::Conductor(_) | Material::ThinDielectric(_)
+        )
     }
 
-    /// Whether light can leave the surface by a perfect mirror or refraction
-    /// (photons aimed at it may make caustics).
+    /// Whether light can leave the surface by a perfect mirror or
+    /// refraction, or a glossy lobe that carries caustics (photons aimed
+    /// at it may make caustics).
     pub fn has_specular_lobe(&self) -> bool {
         match self {
             Material::Phong(p) => max_component(p.mirror_rho()) > 0.0,
+            Material::Plastic(p) => max_component(p.specular) > 0.0,
+            Material::RoughConductor(_) | Material::RoughDielectric(_) | Material::RoughPlastic(_) => {
+                self.glossy().is_some_and(|g| g.carries_caustics())
+            }
             m => m.is_specular(),
         }
     }
 
     /// The diffuse lobe's reflectance: where photons are stored and density
     /// estimates read. `None` where there is none, or it is black (a black
-    /// surface reflects nothing and needs no estimate).
+    /// surface reflects nothing and needs no estimate). For a plastic, its
+    /// base's reflectance; what it reflects towards a direction is
+    /// [`Self::diffuse_albedo`].
     pub fn diffuse_rho(&self) -> Option<Color> {
         let rho = match self {
             Material::Lambertian { rho } => *rho,
             Material::Phong(p) => p.diffuse_rho(),
+            Material::Plastic(p) => p.diffuse,
+            Material::RoughPlastic(p) => p.diffuse,
             _ => return None,
         };
         (max_component(rho) > 0.0).then_some(rho)
     }
 
-    /// The glossy lobe, if the material has one that reflects.
-    pub fn glossy(&self) -> Option<&Phong> {
+    /// What the diffuse lobe reflects towards `wo` of light arriving evenly
+    /// from above (pi times its BRDF where that is constant): the factor a
+    /// density estimate of irradiance takes. Exact for Lambertian and
+    /// Phong; a plastic's depends on where the light arrives from through
+    /// its coat's Fresnel, which an irradiance estimate does not know (its
+    /// direct light, by shadow rays, is exact).
+    #[inline]
+    pub fn diffuse_albedo(&self, wo: Vec3) -> Color {
         match self {
-            Material::Phong(p) if p.is_glossy() => Some(p),
+            Material::Lambertian { rho } => *rho,
+            Material::Phong(p) => p.diffuse_rho(),
+            Material::Plastic(p) => p.diffuse_albedo(wo),
+            Material::RoughPlastic(p) => p.diffuse_albedo(wo),
+            _ => Color::ZERO,
+        }
+    }
+
+    /// The glossy lobe, if the material has one that reflects.
+    #[inline]
+    pub fn glossy(&self) -> Option<Glossy<'_>> {
+        match self {
+            Material::Phong(p) if p.is_glossy() => Some(Glossy::Phong(p)),
+            Material::RoughConductor(c) => Some(Glossy::Conductor(c)),
+            Material::RoughDielectric(d) => Some(Glossy::Dielectric(d)),
+            Material::RoughPlastic(p) if max_component(p.specular) > 0.0 => Some(Glossy::Coat(p)),
             _ => None,
         }
+    }
+
+    /// Whether the smooth lobes let light through (their direct light is
+    /// sought on both sides).
+    #[inline]
+    pub fn transmits(&self) -> bool {
+        matches!(self, Material::RoughDielectric(_))
+    }
+
+    /// Whether the material has a diffuse or glossy lobe (light arriving
+    /// there is estimated, not only followed).
+    #[inline]
+    pub fn has_smooth_lobes(&self) -> bool {
+        self.diffuse_rho().is_some() || self.glossy().is_some()
     }
 
     /// What light travelling inside loses per unit length (Beer–Lambert),
@@ -171,15 +353,23 @@ impl Material {
         }
     }
 
-    /// The chance a photon goes on from this surface (Russian roulette):
-    /// the largest fraction of power the smooth lobes and Phong's mirror
-    /// reflect (Jensen 2001, ch. 5); 1 for mirrors and glass, whose photons
-    /// are never dropped (their chains make the caustics).
-    pub fn photon_survival(&self) -> f32 {
+    /// The chance a photon arriving from `wo` goes on from this surface
+    /// (Russian roulette): the largest fraction of power the smooth lobes
+    /// and Phong's mirror reflect (Jensen 2001, ch. 5), a plastic's towards
+    /// `wo`; 1 for mirrors, glass and metals, whose photons are never
+    /// dropped (their chains make the caustics).
+    pub fn photon_survival(&self, wo: Vec3) -> f32 {
         match self {
             Material::Lambertian { rho } => max_component(*rho).min(1.0),
             Material::Phong(p) => p.lobe_weights().iter().sum::<f32>().min(1.0),
-            Material::Mirror { .. } | Material::Glass { .. } => 1.0,
+            Material::Plastic(p) => p.albedo_bound(wo),
+            Material::RoughPlastic(p) => p.albedo_bound(wo),
+            Material::Mirror { .. }
+            | Material::Glass { .. }
+            | Material::Conductor(_)
+            | Material::ThinDielectric(_)
+            | Material::RoughConductor(_)
+            | Material::RoughDielectric(_) => 1.0,
             Material::Emitter => 0.0,
         }
     }
@@ -204,22 +394,31 @@ impl Material {
         }
     }
 
-    /// The smooth part of the BSDF, f(wo, wi), for local directions on the
-    /// surface's side (zero below it); specular lobes are not included.
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Color {
+    /// The smooth part of the BSDF, f(wo, wi), for local directions: on the
+    /// surface's side, and for rough glass also through it (`wi.z < 0`;
+    /// zero elsewhere); specular lobes are not included. `mode` matters
+    /// only across a boundary (radiance's 1 / eta^2).
+    #[inline]
+    pub fn eval(&self, wo: Vec3, wi: Vec3, entering: bool, mode: Transport) -> Color {
+        if let Material::RoughDielectric(d) = self {
+            return d.eval(wo, wi, entering, mode);
+        }
         if !(wi.z > 0.0) {
             return Color::ZERO;
         }
         match self {
             Material::Lambertian { rho } => *rho / PI,
             Material::Phong(p) => p.diffuse_rho() / PI + p.glossy(wo, wi),
+            Material::RoughConductor(c) => c.eval(wo, wi),
+            Material::Plastic(p) => p.eval(wo, wi),
+            Material::RoughPlastic(p) => p.eval(wo, wi),
             _ => Color::ZERO,
         }
     }
 
     /// The density (per solid angle) with which [`Self::sample`] returns
     /// `wi` through a smooth lobe.
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    pub fn pdf(&self, wo: Vec3, wi: Vec3, entering: bool) -> f32 {
         match self {
             Material::Lambertian { .. } => cosine_hemisphere_pdf(wi),
             Material::Phong(p) => {
@@ -230,6 +429,10 @@ impl Material {
                 }
                 (d * cosine_hemisphere_pdf(wi) + g * p.glossy_pdf(wo, wi)) / total
             }
+            Material::RoughConductor(c) => c.pdf(wo, wi),
+            Material::RoughDielectric(d) => d.pdf(wo, wi, entering),
+            Material::Plastic(p) => p.pdf(wo, wi),
+            Material::RoughPlastic(p) => p.pdf(wo, wi),
             _ => 0.0,
         }
     }
@@ -237,7 +440,9 @@ impl Material {
     /// The perfect reflections and refractions leaving the surface towards
     /// `wo`'s side or through it. Glass: reflection with Fresnel's share
     /// and refraction with the rest (scaled by (n_i / n_t)^2 for radiance),
-    /// or reflection alone past the critical angle.
+    /// or reflection alone past the critical angle. A thin pane: its
+    /// reflectance's share, and straight through with the rest (no change
+    /// of medium, no scale).
     #[inline]
     pub fn specular_branches(&self, wo: Vec3, entering: bool, mode: Transport) -> Branches {
         match *self {
@@ -262,6 +467,32 @@ impl Material {
                     }
                 }
             }
+            Material::Conductor(c) => {
+                let scale = c.reflectance(wo.z);
+                if max_component(scale) > 0.0 {
+                    Branches::one(Branch { wi: reflect(wo), prob: 1.0, scale })
+                } else {
+                    Branches::default()
+                }
+            }
+            Material::ThinDielectric(t) => {
+                let r = t.reflectance(wo.z);
+                let reflected = Branch { wi: reflect(wo), prob: r, scale: t.specular_reflectance };
+                let through = Branch { wi: -wo, prob: 1.0 - r, scale: t.specular_transmittance };
+                if r >= 1.0 {
+                    Branches::one(Branch { prob: 1.0, ..reflected })
+                } else {
+                    Branches { items: [Some(reflected), Some(through)] }
+                }
+            }
+            Material::Plastic(p) => {
+                let scale = p.coat(wo);
+                if max_component(scale) > 0.0 {
+                    Branches::one(Branch { wi: reflect(wo), prob: 1.0, scale })
+                } else {
+                    Branches::default()
+                }
+            }
             _ => Branches::default(),
         }
     }
@@ -274,12 +505,13 @@ impl Material {
     /// surface that reflects nothing, or a glossy sample below the surface.
     pub fn sample(&self, wo: Vec3, entering: bool, mode: Transport, rng: &mut Rng) -> Option<Scatter> {
         let specular = |b: Branch| Scatter { wi: b.wi, weight: b.scale, lobe: Lobe::Specular };
+        let glossy = |(wi, weight): (Vec3, Color)| Scatter { wi, weight, lobe: Lobe::Glossy };
         match self {
             Material::Lambertian { rho } => {
                 // Cosine sampling: f cos / pdf = (rho / pi) cos / (cos / pi) = rho.
                 Some(Scatter { wi: cosine_hemisphere(next_2d(rng)), weight: *rho, lobe: Lobe::Diffuse })
             }
-            Material::Mirror { .. } | Material::Glass { .. } => {
+            Material::Mirror { .. } | Material::Glass { .. } | Material::Conductor(_) | Material::ThinDielectric(_) => {
                 self.specular_branches(wo, entering, mode).choose(rng).map(specular)
             }
             Material::Phong(p) => {
@@ -298,12 +530,32 @@ impl Material {
                     } else {
                         (p.sample_glossy(wo, next_2d(rng))?.0, Lobe::Glossy)
                     };
-                    let pdf = self.pdf(wo, wi);
-                    (pdf > 0.0).then(|| Scatter { wi, weight: self.eval(wo, wi) * (wi.z / pdf), lobe })
+                    let pdf = self.pdf(wo, wi, entering);
+                    (pdf > 0.0).then(|| Scatter { wi, weight: self.eval(wo, wi, entering, mode) * (wi.z / pdf), lobe })
                 } else {
                     let b = self.specular_branches(wo, entering, mode).choose(rng)?;
                     Some(Scatter { weight: b.scale * (total / w[2]), ..specular(b) })
                 }
+            }
+            Material::RoughConductor(c) => c.sample(wo, next_2d(rng)).map(glossy),
+            Material::RoughDielectric(d) => {
+                let u1 = rng.random::<f32>();
+                d.sample(wo, entering, mode, u1, next_2d(rng)).map(glossy)
+            }
+            Material::Plastic(p) => {
+                let (coat, chance) = p.choose_coat(wo, rng.random::<f32>());
+                if coat {
+                    let b = self.specular_branches(wo, entering, mode).choose(rng)?;
+                    return Some(Scatter { weight: b.scale / chance, ..specular(b) });
+                }
+                let wi = cosine_hemisphere(next_2d(rng));
+                let pdf = p.pdf(wo, wi);
+                (pdf > 0.0).then(|| Scatter { wi, weight: p.eval(wo, wi) * (wi.z / pdf), lobe: Lobe::Diffuse })
+            }
+            Material::RoughPlastic(p) => {
+                let u1 = rng.random::<f32>();
+                let (wi, coat, weight) = p.sample(wo, u1, next_2d(rng))?;
+                Some(Scatter { wi, weight, lobe: if coat { Lobe::Glossy } else { Lobe::Diffuse } })
             }
             Material::Emitter => None,
         }
@@ -355,7 +607,7 @@ mod tests {
                 let mut smooth = Color::ZERO.as_dvec3();
                 for _ in 0..n {
                     let wi = uniform_cone(next_2d(&mut rng), 0.0);
-                    smooth += (m.eval(wo, wi) * wi.z * 2.0 * PI).as_dvec3();
+                    smooth += (m.eval(wo, wi, true, Transport::Importance) * wi.z * 2.0 * PI).as_dvec3();
                 }
                 let specular: Color =
                     m.specular_branches(wo, true, Transport::Importance).iter().map(|b| b.prob * b.scale).sum();
@@ -381,7 +633,7 @@ mod tests {
                 if s.lobe == Lobe::Specular {
                     continue;
                 }
-                let want = m.eval(wo, s.wi) * s.wi.z / m.pdf(wo, s.wi);
+                let want = m.eval(wo, s.wi, true, Transport::Radiance) * s.wi.z / m.pdf(wo, s.wi, true);
                 assert!((s.weight - want).abs().max_element() <= 1e-3 * want.max_element(), "{s:?} vs {want}");
                 checked += 1;
             }
@@ -414,8 +666,8 @@ mod tests {
     fn what_photon_mapping_asks_of_each_material() {
         let [lambert, mirror, glass, phong] = materials().try_into().unwrap();
         assert_eq!(lambert.diffuse_rho(), Some(Color::new(0.8, 0.5, 0.2)));
-        assert!((lambert.photon_survival() - 0.8).abs() < 1e-6);
-        assert!(mirror.diffuse_rho().is_none() && mirror.is_specular() && mirror.photon_survival() == 1.0);
+        assert!((lambert.photon_survival(Vec3::Z) - 0.8).abs() < 1e-6);
+        assert!(mirror.diffuse_rho().is_none() && mirror.is_specular() && mirror.photon_survival(Vec3::Z) == 1.0);
         assert!(glass.has_specular_lobe() && glass.absorption().is_none());
         assert!(phong.has_specular_lobe() && phong.glossy().is_some() && phong.diffuse_rho().is_some());
         assert!(Material::Lambertian { rho: Color::ZERO }.diffuse_rho().is_none());

@@ -331,11 +331,12 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
         }
     }
     // Russian roulette: survivors carry power / p.
-    let p = material.photon_survival();
+    let wo = frame.to_local(-ray.dir);
+    let p = material.photon_survival(wo);
     if p < 1.0 && !(rng.random::<f32>() < p) {
         return stop;
     }
-    let Some(scatter) = material.sample(frame.to_local(-ray.dir), entering, Transport::Importance, rng) else {
+    let Some(scatter) = material.sample(wo, entering, Transport::Importance, rng) else {
         return stop;
     };
     let dir = match scatter.lobe {
@@ -355,11 +356,18 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
     if smooth && !hit.leaves_as(ray.dir, dir, scatter.wi.z > 0.0) {
         return stop;
     }
-    match scatter.lobe {
-        Lobe::Specular => *specular_bounces += 1,
-        // A caustic path ends at its first non-specular bounce.
-        _ if pass == Pass::Caustic => return stop,
-        _ => *only_specular_so_far = false,
+    // A glossy lobe that carries caustics stands for a specular one
+    // (material::Glossy).
+    let specular = match scatter.lobe {
+        Lobe::Specular => true,
+        Lobe::Diffuse => false,
+        Lobe::Glossy => material.glossy().is_some_and(|g| g.carries_caustics()),
+    };
+    match specular {
+        true => *specular_bounces += 1,
+        // A caustic path ends at its first bounce that is neither.
+        false if pass == Pass::Caustic => return stop,
+        false => *only_specular_so_far = false,
     }
     *power *= scatter.weight / p;
     if smooth {

@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod chi2;
+
 use photonmap::film::Film;
 use photonmap::metrics::{compare, Metrics};
 use photonmap::output::{read_exr, write};

@@ -25,6 +25,57 @@ pub struct MaterialDef {
     pub m_sm: Option<Spanned<f32>>,
     pub m_sp: Option<Spanned<f32>>,
     pub m_r: Option<Spanned<f32>>,
+    // Mitsuba 3's parameters of its conductors, dielectrics and plastics
+    // (read in mitsuba_bsdf.rs).
+    pub distribution: Option<Spanned<String>>,
+    pub alpha: Option<Spanned<f32>>,
+    pub alpha_u: Option<Spanned<f32>>,
+    pub alpha_v: Option<Spanned<f32>>,
+    pub eta: Option<Spanned<V3>>,
+    pub k: Option<Spanned<V3>>,
+    pub int_ior: Option<Spanned<f32>>,
+    pub ext_ior: Option<Spanned<f32>>,
+    pub specular_reflectance: Option<Spanned<V3>>,
+    pub specular_transmittance: Option<Spanned<V3>>,
+    pub diffuse_reflectance: Option<Spanned<V3>>,
+    pub nonlinear: Option<Spanned<bool>>,
+}
+
+/// Fields by name, with their places where given.
+pub(super) type Present = Vec<(&'static str, Option<Range<usize>>)>;
+
+impl MaterialDef {
+    /// Every field's name and, where given, its place.
+    pub(super) fn present(&self) -> Present {
+        fn span<T>(o: &Option<Spanned<T>>) -> Option<Range<usize>> {
+            o.as_ref().map(|s| s.span())
+        }
+        vec![
+            ("rho", span(&self.rho)),
+            ("reflectance", span(&self.reflectance)),
+            ("ior", span(&self.ior)),
+            ("absorption", span(&self.absorption)),
+            ("color", span(&self.color)),
+            ("m_a", span(&self.m_a)),
+            ("m_l", span(&self.m_l)),
+            ("m_s", span(&self.m_s)),
+            ("m_sm", span(&self.m_sm)),
+            ("m_sp", span(&self.m_sp)),
+            ("m_r", span(&self.m_r)),
+            ("distribution", span(&self.distribution)),
+            ("alpha", span(&self.alpha)),
+            ("alpha_u", span(&self.alpha_u)),
+            ("alpha_v", span(&self.alpha_v)),
+            ("eta", span(&self.eta)),
+            ("k", span(&self.k)),
+            ("int_ior", span(&self.int_ior)),
+            ("ext_ior", span(&self.ext_ior)),
+            ("specular_reflectance", span(&self.specular_reflectance)),
+            ("specular_transmittance", span(&self.specular_transmittance)),
+            ("diffuse_reflectance", span(&self.diffuse_reflectance)),
+            ("nonlinear", span(&self.nonlinear)),
+        ]
+    }
 }
 
 impl Builder<'_> {
@@ -32,26 +83,8 @@ impl Builder<'_> {
         let d = m.get_ref();
         let f = |n: &str| format!("materials.{name}.{n}");
         let kind = at(&d.kind, f("type"));
-        let span = |o: &Option<Spanned<V3>>| o.as_ref().map(|s| s.span());
-        let span1 = |o: &Option<Spanned<f32>>| o.as_ref().map(|s| s.span());
-        let phong_fields = [
-            ("color", span(&d.color)),
-            ("m_a", span1(&d.m_a)),
-            ("m_l", span1(&d.m_l)),
-            ("m_s", span1(&d.m_s)),
-            ("m_sm", span1(&d.m_sm)),
-            ("m_sp", span1(&d.m_sp)),
-            ("m_r", span1(&d.m_r)),
-        ];
         let others = |keep: &[&str]| -> Vec<(&str, Option<Range<usize>>)> {
-            let mut all = vec![
-                ("rho", span(&d.rho)),
-                ("reflectance", span(&d.reflectance)),
-                ("ior", span1(&d.ior)),
-                ("absorption", span(&d.absorption)),
-            ];
-            all.extend(phong_fields.iter().cloned());
-            all.into_iter().filter(|(n, _)| !keep.contains(n)).collect()
+            d.present().into_iter().filter(|(n, _)| !keep.contains(n)).collect()
         };
         match kind.value.as_str() {
             "lambertian" => {
@@ -95,10 +128,16 @@ impl Builder<'_> {
                     mirror: coef(&d.m_r, "m_r", f32::INFINITY)?,
                 }))
             }
+            "conductor" | "roughconductor" | "roughdielectric" | "thindielectric" | "plastic" | "roughplastic" => {
+                self.mitsuba_bsdf(&kind, d, &others)
+            }
             other => self.fail(
                 kind.span.clone(),
                 &kind.field,
-                format!("unknown material type \"{other}\" (lambertian, mirror, glass, phong)"),
+                format!(
+                    "unknown material type \"{other}\" (lambertian, mirror, glass, phong, conductor, roughconductor, \
+                     roughdielectric, thindielectric, plastic, roughplastic)"
+                ),
             ),
         }
     }

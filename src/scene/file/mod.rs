@@ -14,6 +14,7 @@ mod defs;
 mod light;
 mod locate;
 mod material;
+mod mitsuba_bsdf;
 mod shape;
 
 use super::SceneParts;

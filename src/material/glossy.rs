@@ -1,0 +1,94 @@
+//! A material's glossy lobes as photon mapping's estimators see them:
+//! sampled like a path tracer, never stored in a photon map
+//! (notes/method.md). Phong's lobe, a rough metal, rough glass (both of
+//! its sides), a rough plastic's coat.
+//!
+//! A glossy lobe whose roughness is below [`CAUSTIC_ROUGHNESS`] *carries
+//! caustics*: for the split of light paths between the estimators it
+//! stands where a mirror or smooth glass would (caustic photons are traced
+//! on through it and aimed at its object; final gathering from a diffuse
+//! point passes through it counting nothing there). A rougher lobe scatters
+//! light so widely that its caustics are a faint glow better found by
+//! final gathering, which takes the light arriving at it by shadow rays.
+//! Phong's lobe keeps its course-era rule: it never carries caustics.
+
+use super::conductor::RoughConductor;
+use super::dielectric::RoughDielectric;
+use super::plastic::RoughPlastic;
+use super::{Phong, Transport};
+use crate::math::Color;
+use crate::sampling::{next_2d, Rng};
+use glam::Vec3;
+use rand::RngExt;
+
+/// Below this microfacet roughness (the larger alpha), a glossy lobe
+/// carries caustics.
+pub const CAUSTIC_ROUGHNESS: f32 = 0.3;
+
+/// The glossy lobe of a material.
+#[derive(Clone, Copy, Debug)]
+pub enum Glossy<'a> {
+    Phong(&'a Phong),
+    Conductor(&'a RoughConductor),
+    Dielectric(&'a RoughDielectric),
+    /// A rough plastic's coat (its diffuse base is the material's diffuse lobe).
+    Coat(&'a RoughPlastic),
+}
+
+impl Glossy<'_> {
+    /// The glossy lobes' BSDF alone (no diffuse part), for local `wo` and
+    /// `wi` (below the surface: transmission, for rough glass).
+    pub fn eval(&self, wo: Vec3, wi: Vec3, entering: bool, mode: Transport) -> Color {
+        match self {
+            Glossy::Phong(p) => p.glossy(wo, wi),
+            Glossy::Conductor(c) => c.eval(wo, wi),
+            Glossy::Dielectric(d) => d.eval(wo, wi, entering, mode),
+            Glossy::Coat(p) => p.eval_coat(wo, wi),
+        }
+    }
+
+    /// A direction from the glossy lobes alone and its weight f |cos| /
+    /// pdf; `None` where the sample leaves on the wrong side. Phong's lobe
+    /// draws two numbers, as it always has (the same images).
+    pub fn sample(&self, wo: Vec3, entering: bool, mode: Transport, rng: &mut Rng) -> Option<(Vec3, Color)> {
+        match self {
+            Glossy::Phong(p) => p.sample_glossy(wo, next_2d(rng)),
+            Glossy::Conductor(c) => c.sample(wo, next_2d(rng)),
+            Glossy::Dielectric(d) => {
+                let u1 = rng.random::<f32>();
+                d.sample(wo, entering, mode, u1, next_2d(rng))
+            }
+            Glossy::Coat(p) => p.sample_coat(wo, next_2d(rng)),
+        }
+    }
+
+    /// Where a material has both a glossy lobe and specular branches (only
+    /// Phong), the chance that a path going on through one of them takes
+    /// a branch: their albedos' shares.
+    pub fn specular_share(&self) -> f32 {
+        match self {
+            Glossy::Phong(p) => {
+                let [_, g, m] = p.lobe_weights();
+                m / (g + m)
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Whether the lobe stands for a specular one in the split of light
+    /// paths (see the module's documentation).
+    pub fn carries_caustics(&self) -> bool {
+        let roughness = match self {
+            Glossy::Phong(_) => return false,
+            Glossy::Conductor(c) => c.microfacet.roughness(),
+            Glossy::Dielectric(d) => d.microfacet.roughness(),
+            Glossy::Coat(p) => p.microfacet.roughness(),
+        };
+        roughness < CAUSTIC_ROUGHNESS
+    }
+
+    /// Whether the lobe lets light through the surface.
+    pub fn transmits(&self) -> bool {
+        matches!(self, Glossy::Dielectric(_))
+    }
+}

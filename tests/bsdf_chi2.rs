@@ -1,0 +1,168 @@
+//! Every material's sampling against its pdf (χ², tests/common/chi2.rs),
+//! over both distributions, isotropic and anisotropic roughness, several
+//! roughnesses and incident angles, reflection and transmission, both
+//! sides of glass; and the microfacet distributions' visible normals
+//! against their density. Samples from specular branches (deltas, which
+//! no density describes) are left out: the smooth lobes' pdf integrates to
+//! the chance of a smooth lobe, and the harness checks that too.
+
+mod common;
+
+use common::chi2::{gamma_q, Chi2, Outcome};
+use glam::Vec3;
+use photonmap::material::{Distribution, Lobe, Material, Microfacet, Phong, Transport};
+use photonmap::math::Color;
+use photonmap::sampling::{next_2d, stream, Domain};
+
+/// Incident directions: near normal, oblique, grazing (anisotropic lobes
+/// are seen from an azimuth off both axes).
+fn incidences() -> [Vec3; 3] {
+    [
+        Vec3::new(0.2, 0.1, 0.97).normalize(),
+        Vec3::new(0.55, 0.35, 0.6).normalize(),
+        Vec3::new(0.75, -0.6, 0.18).normalize(),
+    ]
+}
+
+const DISTRIBUTIONS: [Distribution; 2] = [Distribution::Beckmann, Distribution::Ggx];
+/// (alpha_u, alpha_v): smooth-ish, rough, anisotropic.
+const ROUGHNESS: [(f32, f32); 3] = [(0.1, 0.1), (0.45, 0.45), (0.12, 0.5)];
+
+/// One material's test from `wo`: its sample against its pdf.
+fn material_outcome(m: &Material, wo: Vec3, entering: bool, seed: u64, tests: usize) -> Outcome {
+    let mut rng = stream(seed, Domain::Camera, 0);
+    let chi2 = Chi2 { tests, ..Chi2::default() };
+    chi2.run(
+        || {
+            m.sample(wo, entering, Transport::Radiance, &mut rng)
+                .filter(|s| s.lobe != Lobe::Specular)
+                .map(|s| s.wi.normalize())
+        },
+        |wi| m.pdf(wo, wi, entering) as f64,
+    )
+}
+
+/// Runs every case, and fails listing those that fail.
+fn check_all(family: &str, cases: Vec<(String, Material, Vec3, bool)>) {
+    let n = cases.len();
+    let mut failed = Vec::new();
+    for (i, (name, m, wo, entering)) in cases.into_iter().enumerate() {
+        let o = material_outcome(&m, wo, entering, 1000 + i as u64, n);
+        println!(
+            "{family} {name} wo {wo:.2} entering {entering}: chi2 {:.1} dof {} p {:.4} (level {:.5}) pdf mass {:.4}",
+            o.statistic, o.dof, o.p_value, o.threshold, o.pdf_mass
+        );
+        if !o.passed() {
+            failed.push(format!("{name} wo {wo}: p {}", o.p_value));
+        }
+    }
+    assert!(failed.is_empty(), "{family}: {failed:?}");
+}
+
+#[test]
+fn microfacet_visible_normals_follow_their_density() {
+    let mut cases = Vec::new();
+    for d in DISTRIBUTIONS {
+        for (au, av) in ROUGHNESS {
+            for wo in incidences() {
+                cases.push((Microfacet::new(d, au, av), wo));
+            }
+        }
+    }
+    let n = cases.len();
+    let mut failed = Vec::new();
+    for (i, (mf, wo)) in cases.into_iter().enumerate() {
+        let mut rng = stream(7, Domain::Camera, i as u64);
+        let o = Chi2 { tests: n, ..Chi2::default() }
+            .run(|| Some(mf.sample_visible(wo, next_2d(&mut rng))), |m| mf.visible_pdf(wo, m) as f64);
+        println!("{mf:?} wo {wo:.2}: chi2 {:.1} dof {} p {:.4} mass {:.4}", o.statistic, o.dof, o.p_value, o.pdf_mass);
+        if !o.passed() {
+            failed.push(format!("{mf:?} {wo}: p {}", o.p_value));
+        }
+    }
+    assert!(failed.is_empty(), "{failed:?}");
+}
+
+#[test]
+fn rough_conductor_samples_follow_its_pdf() {
+    let mut cases = Vec::new();
+    for d in DISTRIBUTIONS {
+        for (au, av) in ROUGHNESS {
+            let m =
+                Material::rough_conductor(d, au, av, Color::new(0.2, 0.9, 1.1), Color::new(3.9, 2.4, 2.2), Color::ONE);
+            for wo in incidences() {
+                cases.push((format!("{} {au}/{av}", d.name()), m, wo, true));
+            }
+        }
+    }
+    check_all("roughconductor", cases);
+}
+
+#[test]
+fn rough_dielectric_samples_follow_its_pdf_both_ways_and_sides() {
+    let mut cases = Vec::new();
+    for d in DISTRIBUTIONS {
+        for (au, av) in ROUGHNESS {
+            let m = Material::rough_dielectric(d, au, av, 1.5, 1.0, Color::ONE, Color::ONE);
+            for wo in incidences() {
+                for entering in [true, false] {
+                    cases.push((format!("{} {au}/{av}", d.name()), m, wo, entering));
+                }
+            }
+        }
+    }
+    check_all("roughdielectric", cases);
+}
+
+#[test]
+fn plastics_lambertian_and_phong_samples_follow_their_pdfs() {
+    let mut cases = Vec::new();
+    let phong = Phong {
+        color: Color::new(0.9, 0.6, 0.3),
+        ambient: 0.0,
+        diffuse: 0.4,
+        specular: 0.3,
+        metalness: 0.2,
+        shininess: 20.0,
+        mirror: 0.2,
+    };
+    let mut materials = vec![
+        ("lambertian".to_string(), Material::Lambertian { rho: Color::new(0.8, 0.5, 0.2) }),
+        ("phong".to_string(), Material::Phong(phong)),
+        ("phong, no mirror".to_string(), Material::Phong(Phong { mirror: 0.0, ..phong })),
+        ("plastic".to_string(), Material::plastic(Color::new(0.6, 0.3, 0.1), Color::ONE, 1.49, 1.0, false)),
+    ];
+    for d in DISTRIBUTIONS {
+        for alpha in [0.1, 0.45] {
+            let m = Material::rough_plastic(d, alpha, Color::new(0.6, 0.3, 0.1), Color::ONE, 1.49, 1.0, true);
+            materials.push((format!("roughplastic {} {alpha}", d.name()), m));
+        }
+    }
+    for (name, m) in materials {
+        for wo in incidences() {
+            cases.push((name.clone(), m, wo, true));
+        }
+    }
+    check_all("diffuse and coated", cases);
+}
+
+/// The harness has power: a cosine sampler tested against the uniform
+/// hemisphere's pdf, and against its own pdf with a few percent of its
+/// mass moved from one azimuth to another, fails; against the right pdf
+/// it passes. And the p-value is the χ² tail (known values).
+#[test]
+fn the_harness_rejects_a_wrong_pdf() {
+    let run = |pdf: &dyn Fn(Vec3) -> f64| {
+        let mut rng = stream(3, Domain::Camera, 0);
+        Chi2::default().run(|| Some(photonmap::sampling::cosine_hemisphere(next_2d(&mut rng))), pdf)
+    };
+    let cosine = |w: Vec3| (w.z.max(0.0) / std::f32::consts::PI) as f64;
+    assert!(run(&cosine).passed());
+    assert!(!run(&|w: Vec3| if w.z > 0.0 { 1.0 / (2.0 * std::f64::consts::PI) } else { 0.0 }).passed());
+    let skewed = |w: Vec3| cosine(w) * (1.0 + 0.05 * w.x.signum() as f64);
+    assert!(!run(&skewed).passed());
+    // Q(k/2, x/2): the chance a χ² of k degrees exceeds x.
+    assert!((gamma_q(0.5, 3.841 / 2.0) - 0.05).abs() < 1e-3);
+    assert!((gamma_q(5.0, 18.307 / 2.0) - 0.05).abs() < 1e-3);
+    assert!((gamma_q(50.0, 124.342 / 2.0) - 0.05).abs() < 1e-3);
+}
