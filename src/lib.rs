@@ -22,6 +22,7 @@
 pub mod accel;
 pub mod camera;
 pub mod display;
+pub mod envmap;
 pub mod error;
 pub mod export;
 pub mod film;

@@ -8,6 +8,7 @@
 //! sample of the light ([`Light::incident`]), and where a photon starts
 //! ([`Light::emit`]).
 
+use crate::envmap::EnvMap;
 use crate::math::{Color, Frame, Ray, Vertex};
 use crate::sampling::{concentric_disk, cosine_hemisphere, uniform_cone, uniform_triangle};
 use crate::shape::{Departure, Disk, Triangle};
@@ -118,7 +119,7 @@ pub struct Incident {
 }
 
 /// A light of the scene.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub enum Light {
     Area(AreaLight),
     /// Emits `intensity` (W/sr) equally in every direction; the Whitted
@@ -151,6 +152,13 @@ pub enum Light {
     /// A pinhole projecting irradiance through a frustum (Mitsuba's
     /// `projector`).
     Projector(Projector),
+    /// Radiance from an environment map at infinity (Mitsuba's `envmap`),
+    /// photons from a disk as for [`Light::Constant`].
+    Envmap {
+        map: std::sync::Arc<EnvMap>,
+        center: Vertex,
+        radius: f32,
+    },
 }
 
 /// A projector at `position` shining along `axes[2]` through the frustum
@@ -324,6 +332,10 @@ impl Light {
             Light::Directional { direction, irradiance, .. } => {
                 Some(Incident { dir: -direction, target: None, intensity: irradiance, prim: None })
             }
+            Light::Envmap { ref map, .. } => {
+                let (dir, pdf) = map.sample(u);
+                (pdf > 0.0).then(|| Incident { dir, target: None, intensity: map.eval(dir) / pdf, prim: None })
+            }
             Light::Constant { radiance, .. } => {
                 // Uniform over the sphere (pdf 1 / 4π); `incident_around`
                 // samples the hemisphere a surface sees instead.
@@ -391,6 +403,7 @@ impl Light {
             Light::Spot(s) => s.solid_angle * s.intensity,
             // Through the disk πR², from every direction: L 4π πR².
             Light::Constant { radiance, radius, .. } => radiance * (4.0 * PI * PI * radius * radius),
+            Light::Envmap { ref map, radius, .. } => map.total() * (PI * radius * radius),
             // dω = cos³θ dA on the plane z = 1: the frustum's area there.
             Light::Projector(p) => p.scaled * (4.0 * p.tan_x * p.tan_y),
         }
@@ -401,23 +414,44 @@ impl Light {
     /// directional: uniform on the covering disk). With these pdfs every
     /// photon of N carries exactly power / N. The departure names the
     /// light's primitive, if it has one. The third value multiplies that
-    /// power where the direction is not drawn in proportion to the light's
-    /// intensity (a spot's falloff: uniform in its cone, weighted).
+    /// power, per channel, where the direction is not drawn in proportion
+    /// to the light's intensity (a spot's falloff: uniform in its cone,
+    /// weighted; an environment map's colours).
     #[inline]
-    pub fn emit(&self, u_pos: Vec2, u_dir: Vec2) -> (Ray, Option<Departure>, f32) {
+    pub fn emit(&self, u_pos: Vec2, u_dir: Vec2) -> (Ray, Option<Departure>, Color) {
         match *self {
             Light::Area(a) => {
                 let p = a.sample_point(u_pos).point;
                 // Unit to rounding without normalising (`Frame::to_world`):
                 // the first ray waits on it.
                 let dir = a.frame.to_world(cosine_hemisphere(u_dir));
-                (Ray::new(p, dir), Some(Departure { prim: a.prim, outward: true }), 1.0)
+                (Ray::new(p, dir), Some(Departure { prim: a.prim, outward: true }), Color::ONE)
             }
-            Light::Point { position, .. } => (Ray::new(position, uniform_cone(u_dir, -1.0).normalize()), None, 1.0),
+            Light::Point { position, .. } => {
+                (Ray::new(position, uniform_cone(u_dir, -1.0).normalize()), None, Color::ONE)
+            }
             Light::Directional { direction, reach, .. } => {
                 let frame = Frame::from_normal(direction);
                 let d = concentric_disk(u_pos) * reach.1;
-                (Ray::new(reach.0 + frame.s * d.x + frame.t * d.y, direction), None, 1.0)
+                (Ray::new(reach.0 + frame.s * d.x + frame.t * d.y, direction), None, Color::ONE)
+            }
+            Light::Envmap { ref map, center, radius } => {
+                // A direction drawn from the map; its photon carries
+                // L / (pdf ∫ L dω) of the mean share, per channel.
+                let (towards, pdf) = map.sample(u_dir);
+                let dir = -towards;
+                let total = map.total();
+                let l = map.eval(towards);
+                let weight = Color::new(
+                    if total.x > 0.0 { l.x / (pdf * total.x) } else { 0.0 },
+                    if total.y > 0.0 { l.y / (pdf * total.y) } else { 0.0 },
+                    if total.z > 0.0 { l.z / (pdf * total.z) } else { 0.0 },
+                );
+                let origin = center - dir * (2.0 * radius);
+                let frame = Frame::from_normal(dir);
+                let d = concentric_disk(u_pos) * radius;
+                let weight = if pdf > 0.0 && weight.is_finite() { weight } else { Color::ZERO };
+                (Ray::new(origin + frame.s * d.x + frame.t * d.y, dir), None, weight)
             }
             Light::Constant { center, radius, .. } => {
                 // Travelling along a uniform direction, from a uniform
@@ -426,14 +460,14 @@ impl Light {
                 let origin = center - dir * (2.0 * radius);
                 let frame = Frame::from_normal(dir);
                 let d = concentric_disk(u_pos) * radius;
-                (Ray::new(origin + frame.s * d.x + frame.t * d.y, dir), None, 1.0)
+                (Ray::new(origin + frame.s * d.x + frame.t * d.y, dir), None, Color::ONE)
             }
             Light::Projector(p) => {
                 // Uniform on the frustum's window at z = 1: in proportion to
                 // the intensity, as dω = cos³θ dA.
                 let (x, y) = ((2.0 * u_dir.x - 1.0) * p.tan_x, (2.0 * u_dir.y - 1.0) * p.tan_y);
                 let dir = (p.axes[0] * x + p.axes[1] * y + p.axes[2]).normalize();
-                (Ray::new(p.position, dir), None, 1.0)
+                (Ray::new(p.position, dir), None, Color::ONE)
             }
             Light::Spot(s) => {
                 let local = uniform_cone(u_dir, s.cos_cutoff);
@@ -441,7 +475,7 @@ impl Light {
                 // (I falloff / pdf) / (I ∫ falloff dω), pdf = 1 / cone's solid angle.
                 let cone = 2.0 * PI * (1.0 - s.cos_cutoff);
                 let weight = if s.solid_angle > 0.0 { s.falloff(local.z) * cone / s.solid_angle } else { 0.0 };
-                (Ray::new(s.position, dir), None, weight)
+                (Ray::new(s.position, dir), None, Color::splat(weight))
             }
         }
     }

@@ -431,3 +431,49 @@ fn a_projector_lights_a_facing_plane_evenly() {
     assert_eq!(film.get(0, 0), Vec3::ZERO);
     assert!((film.get(8, 8).x - 0.6).abs() < 1e-4);
 }
+
+/// The furnace again with the sky an environment map of constant value
+/// (an EXR written here): the map's sampling, its pdf and its photons give
+/// the same answer as the constant sky; a map turned by to_world too.
+#[test]
+fn a_diffuse_sphere_in_a_uniform_environment_map() {
+    let dir = scratch_dir("mitsuba_envmap");
+    let sky = photonmap::film::Film { width: 16, height: 8, pixels: vec![Vec3::splat(2.0); 128] };
+    photonmap::output::write(&dir.join("sky.exr"), &sky, Default::default(), 1.0).unwrap();
+    for turn in ["", r#"<transform name="to_world"><rotate x="1" angle="30"/></transform>"#] {
+        let text = format!(
+            r#"<scene version="3.0.0">
+  <sensor type="perspective"><float name="fov" value="60"/>
+    <transform name="to_world"><lookat origin="0,0,-3" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film>
+  </sensor>
+  <shape type="sphere"><bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape>
+  <emitter type="envmap"><string name="filename" value="sky.exr"/>{turn}</emitter>
+</scene>"#
+        );
+        let f = write(&dir, "e.xml", &text);
+        let scene = Scene::from_parts(read(&f, &[]).unwrap().file.parts);
+        for method in [Method::Path, Method::Photon] {
+            let settings = Settings {
+                method,
+                photons: 20_000,
+                caustic_photons: 0,
+                spp: 256,
+                width: 16,
+                height: 16,
+                ..Settings::default()
+            };
+            let film = render_quiet(&scene, &settings);
+            // The mean of the sphere's middle 6 x 6 pixels (the map is
+            // sampled over the whole sphere of directions: noisy per pixel).
+            let centre: Vec3 =
+                (5..11).flat_map(|r| (5..11).map(move |c| (c, r))).map(|(c, r)| film.get(c, r)).sum::<Vec3>() / 36.0;
+            assert!((centre - Vec3::ONE).abs().max_element() < 0.03, "{method:?}: sphere {centre}");
+            assert!(
+                (film.get(0, 0) - Vec3::splat(2.0)).abs().max_element() < 1e-5,
+                "{method:?}: sky {}",
+                film.get(0, 0)
+            );
+        }
+    }
+}

@@ -251,6 +251,12 @@ pub fn to_mitsuba(
                     rgb(irradiance)
                 );
             }
+            LightSpec::Envmap(_) => {
+                return Err(refuse(
+                    light_place(),
+                    "the environment map's export to Mitsuba is not written yet".to_string(),
+                ));
+            }
             LightSpec::Projector(_) => {
                 return Err(refuse(light_place(), "the projector's export to Mitsuba is not written yet".to_string()));
             }

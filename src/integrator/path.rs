@@ -57,7 +57,7 @@ impl Integrator for PathIntegrator<'_> {
             let Some(hit) = self.scene.intersect(&ray, departure) else {
                 // Light from everywhere, where shadow rays did not count it.
                 if count_emission && wanted && !hidden {
-                    radiance += throughput * self.scene.background();
+                    radiance += throughput * self.scene.background(ray.dir);
                 }
                 break;
             };

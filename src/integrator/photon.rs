@@ -185,7 +185,7 @@ impl<'a> PhotonIntegrator<'a> {
         // glowing one, or light from everywhere) is counted.
         let seen = part != Part::Reflected && within(depth + 1) && !(depth == 0 && limits.hide_emitters);
         let Some(hit) = self.scene.intersect(&ray, departure) else {
-            return if seen { self.scene.background() } else { Color::ZERO };
+            return if seen { self.scene.background(ray.dir) } else { Color::ZERO };
         };
         let through = self.scene.transmittance(departure, hit.t);
         let w = w * through;

@@ -114,7 +114,7 @@ fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> (Option<usize>, Opt
         Pass::Global => {
             // The light's natural distribution: each photon carries power / n.
             let (ray, departure, weight) = light.emit(next_2d(rng), next_2d(rng));
-            (None, Some((ray, departure, light.power() * (scale * weight))))
+            (None, Some((ray, departure, light.power() * scale * weight)))
         }
         Pass::Caustic => {
             let targets = scene.specular_targets();
@@ -140,6 +140,16 @@ fn aim(
     // directional light of irradiance L 4π along it.
     let parallel = match *light {
         Light::Directional { direction, irradiance, reach } => Some((direction, irradiance, reach)),
+        Light::Envmap { ref map, center, radius } => {
+            // A direction drawn from the map: a directional light of
+            // irradiance L / pdf along it.
+            let (towards, pdf) = map.sample(next_2d(rng));
+            if !(pdf > 0.0) {
+                return None;
+            }
+            let direction = -towards;
+            Some((direction, map.eval(towards) / pdf, (center - direction * (2.0 * radius), radius)))
+        }
         Light::Constant { radiance, center, radius } => {
             let direction = uniform_cone(next_2d(rng), -1.0).normalize();
             Some((direction, radiance * (4.0 * PI), (center - direction * (2.0 * radius), radius)))
@@ -176,7 +186,7 @@ fn aim(
         Light::Point { position, .. } => (*position, None),
         Light::Spot(s) => (s.position, None),
         Light::Projector(p) => (p.position, None),
-        Light::Directional { .. } | Light::Constant { .. } => unreachable!("handled above"),
+        Light::Directional { .. } | Light::Constant { .. } | Light::Envmap { .. } => unreachable!("handled above"),
     };
     let (axis, cos_max) = chosen.cone_from(origin);
     // Unit to rounding without normalising (`Frame::to_world`).
@@ -213,7 +223,7 @@ fn aim(
         Light::Point { intensity, .. } => *intensity,
         Light::Spot(s) => s.intensity_towards(dir.normalize()),
         Light::Projector(p) => p.intensity_towards(dir.normalize()),
-        Light::Directional { .. } | Light::Constant { .. } => unreachable!("handled above"),
+        Light::Directional { .. } | Light::Constant { .. } | Light::Envmap { .. } => unreachable!("handled above"),
     };
     Some((Ray::new(origin, dir), departure, intensity * scale / pdf_dir))
 }

@@ -172,13 +172,14 @@ pub struct Scene {
     back_material: Vec<u32>,
     pub paths: PathLimits,
     background: Color,
+    envmap: Option<std::sync::Arc<crate::envmap::EnvMap>>,
 }
 
 /// Marks a primitive that is not a light's surface.
 const NO_LIGHT: u32 = u32::MAX;
 
 /// A light as a scene describes it, before the scene places it.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub enum LightSpec {
     /// A one-sided Lambertian emitter; it becomes a primitive of the scene,
     /// of `material` when it also reflects (a glowing wall), else a pure
@@ -205,6 +206,8 @@ pub enum LightSpec {
     },
     /// A projector ([`crate::light::Projector`]).
     Projector(crate::light::Projector),
+    /// An environment map at infinity ([`crate::envmap::EnvMap`]).
+    Envmap(std::sync::Arc<crate::envmap::EnvMap>),
     /// A cone of light from `position` along unit `axis` ([`crate::light::Spot`]).
     Spot {
         position: Vertex,
@@ -271,7 +274,7 @@ impl SceneParts {
                     *position *= s;
                     *intensity *= s * s;
                 }
-                LightSpec::Directional { .. } | LightSpec::Constant { .. } => {}
+                LightSpec::Directional { .. } | LightSpec::Constant { .. } | LightSpec::Envmap(_) => {}
                 LightSpec::Projector(p) => {
                     p.position *= s;
                     p.scaled *= s * s;
@@ -367,6 +370,9 @@ impl Scene {
                 LightSpec::Constant { radiance } => {
                     lights.push(Light::Constant { radiance, center: Vec3::ZERO, radius: 0.0 });
                 }
+                LightSpec::Envmap(ref map) => {
+                    lights.push(Light::Envmap { map: map.clone(), center: Vec3::ZERO, radius: 0.0 });
+                }
                 LightSpec::Projector(p) => {
                     lo = lo.min(p.position);
                     hi = hi.max(p.position);
@@ -387,7 +393,9 @@ impl Scene {
         for l in &mut lights {
             match l {
                 Light::Directional { direction, reach, .. } => *reach = directional_reach(*direction, lo, hi),
-                Light::Constant { center, radius, .. } => (*center, *radius) = directional_reach(Vec3::ZERO, lo, hi),
+                Light::Constant { center, radius, .. } | Light::Envmap { center, radius, .. } => {
+                    (*center, *radius) = directional_reach(Vec3::ZERO, lo, hi)
+                }
                 _ => {}
             }
         }
@@ -398,6 +406,10 @@ impl Scene {
                 _ => Color::ZERO,
             })
             .sum();
+        let envmap = lights.iter().find_map(|l| match l {
+            Light::Envmap { map, .. } => Some(map.clone()),
+            _ => None,
+        });
         let targets = specular_targets(&prims, &materials);
         // Lights stay out of the enclosure: their hits must name them.
         let group: Vec<Option<u32>> =
@@ -420,14 +432,18 @@ impl Scene {
             back_material,
             paths,
             background,
+            envmap,
         }
     }
 
-    /// Radiance arriving along a ray that leaves the scene (light from
-    /// everywhere; black without it).
+    /// Radiance arriving along a ray travelling along `dir` that leaves the
+    /// scene (light from everywhere; black without it).
     #[inline]
-    pub fn background(&self) -> Color {
-        self.background
+    pub fn background(&self, dir: Vec3) -> Color {
+        match &self.envmap {
+            None => self.background,
+            Some(map) => self.background + map.eval(dir),
+        }
     }
 
     #[inline]

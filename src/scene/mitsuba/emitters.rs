@@ -14,7 +14,8 @@ use glam::{DAffine3, DVec3};
 
 impl Builder<'_> {
     pub(super) fn emitter(&mut self, p: &Plugin) -> Result<(), SceneError> {
-        match light_of(p) {
+        let spec = if p.kind == "envmap" { self.envmap(p) } else { light_of(p) };
+        match spec {
             Ok(spec) => {
                 self.lights.push(spec);
                 self.origins.lights.push(super::place(p));
@@ -22,6 +23,39 @@ impl Builder<'_> {
             }
             Err(e) => self.substitute(p, "the emitter is left out", e),
         }
+    }
+}
+
+impl Builder<'_> {
+    /// An environment map from a latitude-longitude EXR.
+    fn envmap(&mut self, p: &Plugin) -> Result<LightSpec, SceneError> {
+        let (name, loc) = p.string("filename")?.ok_or_else(|| p.refuse("an envmap needs a filename"))?;
+        let scale = p.float_in("scale", 1.0, 0.0, 1e30)?;
+        let m = p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
+        if p.boolean("mis_compensation", false)? {
+            return Err(p.fail(p.loc(), "mis_compensation", "is not supported"));
+        }
+        p.finish("filename, scale, to_world, mis_compensation (false)")?;
+        if !name.to_lowercase().ends_with(".exr") {
+            return Err(p.fail(&loc, "filename", format!("'{name}': only OpenEXR environment maps are read yet")));
+        }
+        let path = self.resolve(&name, &loc)?;
+        let image =
+            crate::output::read_exr(&path).map_err(|e| p.fail(&loc, "filename", format!("{}: {e}", path.display())))?;
+        if image.pixels.iter().any(|c| !c.is_finite()) {
+            return Err(p.fail(&loc, "filename", "the map holds non-finite values"));
+        }
+        let r = m.matrix3;
+        let (x, y, z) = (r.x_axis, r.y_axis, r.z_axis);
+        let orthonormal = [x, y, z].iter().all(|a| (a.length() - 1.0).abs() < 1e-4)
+            && x.dot(y).abs() < 1e-4
+            && x.dot(z).abs() < 1e-4
+            && y.dot(z).abs() < 1e-4;
+        if !orthonormal {
+            return Err(p.fail(p.loc(), "to_world", "an environment map's transform must be a rotation"));
+        }
+        let to_world = r.as_mat3();
+        Ok(LightSpec::Envmap(std::sync::Arc::new(crate::envmap::EnvMap::new(&image, scale as f32, to_world))))
     }
 }
 
@@ -94,7 +128,6 @@ fn light_of(p: &Plugin) -> Result<LightSpec, SceneError> {
             p.finish("radiance")?;
             LightSpec::Constant { radiance }
         }
-        "envmap" => return Err(p.refuse("the 'envmap' emitter is not supported yet ('constant' is)")),
         k => {
             return Err(p.refuse(format!(
                 "the '{k}' emitter is not supported yet (point, directional, spot, constant and area are)"

@@ -7,7 +7,7 @@
 use super::props::Plugin;
 use super::spectrum::{named_ior, Use};
 use super::Builder;
-use crate::material::Material;
+use crate::material::{Distribution, Material};
 use crate::math::Color;
 use crate::scene::file::SceneError;
 
@@ -59,26 +59,57 @@ fn bsdf_of(p: &Plugin) -> Result<Built, SceneError> {
             p.finish("int_ior, ext_ior")?;
             Ok((Material::glass((int / ext) as f32), false))
         }
-        "conductor" => {
-            let name = p.string("material")?;
-            let tint = p.color("specular_reflectance", Use::Reflectance)?.unwrap_or(Color::ONE);
-            match name {
-                Some((m, _)) if m == "none" => {}
-                Some((m, loc)) => {
-                    return Err(p.fail(
-                        &loc,
-                        "material",
-                        format!("the named conductor '{m}' is not supported yet (only 'none', a perfect mirror)"),
-                    ))
-                }
-                None if p.el.children.iter().any(|c| matches!(c.attr("name"), Some("eta" | "k"))) => {
-                    return Err(p.refuse("a conductor's eta and k (complex Fresnel) are not supported yet; 'none' is"))
-                }
-                // Mitsuba's default is 'none', a perfect mirror.
-                None => {}
+        "conductor" | "roughconductor" => {
+            let (eta, k) = complex_ior(p)?;
+            let specular = p.color("specular_reflectance", Use::Reflectance)?.unwrap_or(Color::ONE);
+            let specular = bounded(p, "specular_reflectance", specular)?;
+            if p.kind == "conductor" {
+                p.finish("material, eta, k, specular_reflectance")?;
+                return Ok((Material::conductor(eta, k, specular), true));
             }
-            p.finish("material ('none'), specular_reflectance")?;
-            Ok((Material::Mirror { reflectance: bounded(p, "specular_reflectance", tint)? }, true))
+            let (distribution, au, av) = microfacet(p, true)?;
+            p.finish("material, eta, k, specular_reflectance, distribution, alpha, alpha_u, alpha_v, sample_visible")?;
+            Ok((Material::rough_conductor(distribution, au, av, eta, k, specular), true))
+        }
+        "roughdielectric" | "thindielectric" => {
+            let (int, ext) = (ior(p, "int_ior", "bk7")?, ior(p, "ext_ior", "air")?);
+            if int == ext {
+                return Err(p.refuse("the interior and exterior indices of refraction must differ"));
+            }
+            let r = p.color("specular_reflectance", Use::Reflectance)?.unwrap_or(Color::ONE);
+            let t = p.color("specular_transmittance", Use::Reflectance)?.unwrap_or(Color::ONE);
+            let (r, t) = (bounded(p, "specular_reflectance", r)?, bounded(p, "specular_transmittance", t)?);
+            if p.kind == "thindielectric" {
+                p.finish("int_ior, ext_ior, specular_reflectance, specular_transmittance")?;
+                return Ok((Material::thin_dielectric(int as f32, ext as f32, r, t), false));
+            }
+            let (distribution, au, av) = microfacet(p, true)?;
+            p.finish(
+                "int_ior, ext_ior, specular_reflectance, specular_transmittance, distribution, alpha, alpha_u, \
+                 alpha_v, sample_visible",
+            )?;
+            Ok((Material::rough_dielectric(distribution, au, av, int as f32, ext as f32, r, t), false))
+        }
+        "plastic" | "roughplastic" => {
+            let (int, ext) = (ior(p, "int_ior", "polypropylene")?, ior(p, "ext_ior", "air")?);
+            if int == ext {
+                return Err(p.refuse("the interior and exterior indices of refraction must differ"));
+            }
+            let diffuse = p.color("diffuse_reflectance", Use::Reflectance)?.unwrap_or(Color::splat(0.5));
+            let diffuse = bounded(p, "diffuse_reflectance", diffuse)?;
+            let specular = p.color("specular_reflectance", Use::Reflectance)?.unwrap_or(Color::ONE);
+            let specular = bounded(p, "specular_reflectance", specular)?;
+            let nonlinear = p.boolean("nonlinear", false)?;
+            if p.kind == "plastic" {
+                p.finish("int_ior, ext_ior, diffuse_reflectance, specular_reflectance, nonlinear")?;
+                return Ok((Material::plastic(diffuse, specular, int as f32, ext as f32, nonlinear), true));
+            }
+            let (distribution, au, _) = microfacet(p, false)?;
+            p.finish(
+                "int_ior, ext_ior, diffuse_reflectance, specular_reflectance, nonlinear, distribution, alpha, \
+                 sample_visible",
+            )?;
+            Ok((Material::rough_plastic(distribution, au, diffuse, specular, int as f32, ext as f32, nonlinear), true))
         }
         "twosided" => {
             let inner = p.objects("bsdf")?;
@@ -93,7 +124,8 @@ fn bsdf_of(p: &Plugin) -> Result<Built, SceneError> {
             }
         }
         k => Err(p.refuse(format!(
-            "the '{k}' BSDF is not supported yet (diffuse, dielectric, conductor 'none' and twosided are)"
+            "the '{k}' BSDF is not supported yet (diffuse, dielectric, thindielectric, roughdielectric, conductor, \
+             roughconductor, plastic, roughplastic and twosided are)"
         ))),
     }
 }
@@ -122,4 +154,53 @@ fn ior(p: &Plugin, name: &str, default: &str) -> Result<f64, SceneError> {
         return Err(p.fail(p.loc(), name, format!("must lie in (0, 100), got {v}")));
     }
     Ok(v)
+}
+
+/// A conductor's complex index: `eta` and `k`, or a named `material`
+/// ('none': a perfect mirror, eta 0 + 1i).
+fn complex_ior(p: &Plugin) -> Result<(Color, Color), SceneError> {
+    let eta = p.color("eta", Use::Unbounded)?;
+    let k = p.color("k", Use::Unbounded)?;
+    let material = p.string("material")?;
+    match (material, eta, k) {
+        (Some((m, loc)), Some(_), _) | (Some((m, loc)), _, Some(_)) if m != "none" => {
+            Err(p.fail(&loc, "material", format!("give either eta and k or a material ('{m}'), not both")))
+        }
+        (Some((m, loc)), None, None) if m != "none" => Err(p.fail(
+            &loc,
+            "material",
+            format!("the named conductor '{m}' is not supported yet; give eta and k (or 'none', a perfect mirror)"),
+        )),
+        (_, eta, k) => Ok((eta.unwrap_or(Color::ZERO), k.unwrap_or(Color::ONE))),
+    }
+}
+
+/// A microfacet distribution as Mitsuba reads it: `distribution`
+/// (beckmann by default, or ggx), `alpha` (0.1 by default) or, where
+/// `anisotropic`, `alpha_u` and `alpha_v` together; `sample_visible` is
+/// read and its sampling always used (it changes the noise, not the image).
+fn microfacet(p: &Plugin, anisotropic: bool) -> Result<(Distribution, f32, f32), SceneError> {
+    let distribution = match p.string("distribution")? {
+        None => Distribution::Beckmann,
+        Some((d, loc)) => match d.to_lowercase().as_str() {
+            "beckmann" => Distribution::Beckmann,
+            "ggx" => Distribution::Ggx,
+            _ => return Err(p.fail(&loc, "distribution", format!("'{d}' is not beckmann or ggx"))),
+        },
+    };
+    p.boolean("sample_visible", true)?;
+    let alpha = p.float("alpha")?;
+    let (au, av) = if anisotropic { (p.float("alpha_u")?, p.float("alpha_v")?) } else { (None, None) };
+    let (au, av) = match (alpha, au, av) {
+        (Some(a), None, None) => (a, a),
+        (None, Some(u), Some(v)) => (u, v),
+        (None, None, None) => (0.1, 0.1),
+        _ => return Err(p.refuse("give either alpha or both alpha_u and alpha_v")),
+    };
+    for (name, a) in [("alpha", au), ("alpha", av)] {
+        if !(a >= 0.0 && a <= 10.0) {
+            return Err(p.fail(p.loc(), name, format!("must lie in [0, 10], got {a}")));
+        }
+    }
+    Ok((distribution, au as f32, av as f32))
 }
