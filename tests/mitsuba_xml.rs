@@ -363,3 +363,65 @@ fn ply_meshes_and_instances() {
     let (lo, hi) = bounds(&tris);
     assert_eq!((lo.z, hi.z), (3.0, 5.0));
 }
+
+/// A serialized file of version 4 with two shapes, written here as
+/// Mitsuba lays it out: each shape a header and a zlib stream, then the
+/// dictionary of offsets and the count.
+fn serialized_file(shapes: &[&[[f32; 3]]]) -> Vec<u8> {
+    use std::io::Write;
+    let mut f = Vec::new();
+    let mut offsets = Vec::new();
+    for positions in shapes {
+        offsets.push(f.len() as u64);
+        f.extend(0x041Cu16.to_le_bytes());
+        f.extend(4u16.to_le_bytes());
+        let mut body = Vec::new();
+        body.extend(0x1000u32.to_le_bytes());
+        body.extend(b"mesh\0");
+        body.extend((positions.len() as u64).to_le_bytes());
+        body.extend((positions.len() as u64 / 3).to_le_bytes());
+        body.extend(positions.iter().flatten().flat_map(|x| x.to_le_bytes()));
+        body.extend((0..positions.len() as u32).flat_map(|i| i.to_le_bytes()));
+        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+        z.write_all(&body).unwrap();
+        f.extend(z.finish().unwrap());
+    }
+    f.extend(offsets.iter().flat_map(|o| o.to_le_bytes()));
+    f.extend((offsets.len() as u32).to_le_bytes());
+    f
+}
+
+#[test]
+fn serialized_meshes_by_shape_index() {
+    let dir = scratch_dir("mitsuba_serialized");
+    let first: &[[f32; 3]] = &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let second: &[[f32; 3]] =
+        &[[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 0.0], [0.0, -2.0, 0.0], [2.0, 0.0, 0.0]];
+    std::fs::write(dir.join("two.serialized"), serialized_file(&[first, second])).unwrap();
+    let shape = |extra: &str| {
+        scene(&format!(
+            r#"<shape type="serialized"><string name="filename" value="two.serialized"/>{extra}
+                 <transform name="to_world"><translate z="4"/></transform></shape>"#
+        ))
+    };
+    let tris = triangles(&read(&write(&dir, "a.xml", &shape("")), &[]).unwrap().file.parts);
+    assert_eq!(tris, vec![[Vec3::new(0.0, 0.0, 4.0), Vec3::X + 4.0 * Vec3::Z, Vec3::Y + 4.0 * Vec3::Z]]);
+    let f = write(
+        &dir,
+        "b.xml",
+        &shape(r#"<integer name="shape_index" value="1"/><boolean name="flip_normals" value="true"/>"#),
+    );
+    let tris = triangles(&read(&f, &[]).unwrap().file.parts);
+    assert_eq!(tris.len(), 2);
+    assert_eq!(bounds(&tris), (Vec3::new(0.0, -2.0, 4.0), Vec3::new(2.0, 2.0, 4.0)));
+    // flip_normals turns the surface over: the winding now faces -z.
+    for t in &tris {
+        assert!((t[1] - t[0]).cross(t[2] - t[0]).z < 0.0, "{t:?}");
+    }
+    let f = write(&dir, "c.xml", &shape(r#"<integer name="shape_index" value="2"/>"#));
+    let e = read(&f, &[]).unwrap_err();
+    assert!(e.contains("c.xml:") && e.contains("shape 2") && e.contains("holds 2 shapes"), "{e}");
+    let f = write(&dir, "d.xml", &shape(r#"<integer name="shape_index" value="-1"/>"#));
+    let e = read(&f, &[]).unwrap_err();
+    assert!(e.contains("d.xml:") && e.contains("shape_index") && e.contains("-1"), "{e}");
+}

@@ -15,6 +15,7 @@ pub mod mitsuba;
 pub mod ply;
 pub mod procedural;
 mod room;
+pub mod serialized;
 
 pub use room::{tncg15_room, Eye};
 

@@ -17,6 +17,7 @@ use crate::math::Color;
 use crate::scene::file::SceneError;
 use crate::scene::mesh::load_obj;
 use crate::scene::ply::load_ply;
+use crate::scene::serialized::load_serialized;
 use crate::scene::{LightSpec, Prim};
 use crate::shape::{Disk, Ellipsoid, Shape, Sphere, Triangle};
 use glam::{Affine3A, DAffine3, DVec3, Vec3};
@@ -55,7 +56,7 @@ impl Builder<'_> {
             }
             _ => {}
         }
-        for medium in p.objects("medium")? {
+        if let Some(medium) = p.objects("medium")?.first() {
             return Err(medium.refuse("participating media are not supported yet"));
         }
         let bsdf = p.object("bsdf")?;
@@ -80,7 +81,7 @@ impl Builder<'_> {
         }
         let object = self.new_object();
         let mesh = match p.kind {
-            "obj" | "ply" => {
+            "obj" | "ply" | "serialized" => {
                 let face_normals = p.boolean("face_normals", false)?;
                 let (name, loc) = p.string("filename")?.ok_or_else(|| p.refuse("needs a filename"))?;
                 let path = self.resolve(&name, &loc)?;
@@ -90,7 +91,16 @@ impl Builder<'_> {
                     let m = load_obj(&path).map_err(|e| p.fail(&loc, "filename", e))?;
                     (m.triangles, m.normals, None)
                 } else {
-                    let m = load_ply(&path).map_err(|e| p.fail(&loc, "filename", e))?;
+                    let m = if p.kind == "ply" {
+                        load_ply(&path).map_err(|e| p.fail(&loc, "filename", e))?
+                    } else {
+                        // The file's own face-normal flag is not read: Mitsuba 3
+                        // takes the parameter alone (serialized.cpp, load_legacy).
+                        let index = p.integer("shape_index")?.unwrap_or(0);
+                        let index = u32::try_from(index)
+                            .map_err(|_| p.fail(p.loc(), "shape_index", format!("must be 0 or more, got {index}")))?;
+                        load_serialized(&path, index).map_err(|e| p.fail(&loc, "filename", e))?.mesh
+                    };
                     let tris: Vec<[Vec3; 3]> = m.triangles.iter().map(|t| t.map(|i| m.positions[i as usize])).collect();
                     let normals = m.normals.as_ref().map(|n| m.triangles.iter().map(|t| t.map(|i| n[i as usize])).collect());
                     (tris, normals, Some(m.triangles.clone()))
@@ -133,11 +143,11 @@ impl Builder<'_> {
             }
             k => {
                 return Err(p.refuse(format!(
-                    "the '{k}' shape is not supported yet (obj, ply, rectangle, cube, sphere, disk, shapegroup, instance are)"
+                    "the '{k}' shape is not supported yet (obj, ply, serialized, rectangle, cube, sphere, disk, shapegroup, instance are)"
                 )))
             }
         };
-        p.finish("filename, face_normals, flip_normals, flip_tex_coords, to_world, center, radius, bsdf, emitter")?;
+        p.finish("filename, shape_index, face_normals, flip_normals, flip_tex_coords, to_world, center, radius, bsdf, emitter")?;
         match mesh {
             Mesh::Analytic(shape) => match (radiance, shape) {
                 (None, shape) => self.prims.push(Prim { shape, material, object }),
