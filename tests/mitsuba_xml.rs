@@ -425,3 +425,42 @@ fn serialized_meshes_by_shape_index() {
     let e = read(&f, &[]).unwrap_err();
     assert!(e.contains("d.xml:") && e.contains("shape_index") && e.contains("-1"), "{e}");
 }
+
+/// Mitsuba's cylinder: `radius` about the segment `p0`-`p1`, carried by
+/// `to_world` (which may stretch it along its axis, not across it).
+#[test]
+fn cylinders_follow_p0_p1_radius_and_to_world() {
+    let dir = scratch_dir("mitsuba_cylinder");
+    let cylinder = |body: &str, transform: &str| {
+        scene(&format!(r#"<shape type="cylinder">{body}<transform name="to_world">{transform}</transform></shape>"#))
+    };
+    let get = |name: &str, text: String| {
+        let parts = read(&write(&dir, name, &text), &[]).map(|i| i.file.parts);
+        parts.map(|p| match p.prims.iter().map(|p| p.shape).collect::<Vec<_>>()[..] {
+            [Shape::Cylinder(c)] => c,
+            ref other => panic!("{other:?}"),
+        })
+    };
+    let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-5;
+    // Defaults: the unit tube from the origin up z, then moved by to_world.
+    let c = get("a.xml", cylinder("", r#"<scale value="2"/><rotate x="1" angle="90"/><translate z="5"/>"#)).unwrap();
+    assert!(close(c.p0, Vec3::new(0.0, 0.0, 5.0)) && close(c.p1(), Vec3::new(0.0, -2.0, 5.0)), "{c:?}");
+    assert!((c.radius - 2.0).abs() < 1e-6 && !c.flip);
+    let body = r#"<point name="p0" x="1" y="0" z="0"/><point name="p1" x="1" y="0" z="3"/><float name="radius" value="0.5"/>
+                  <boolean name="flip_normals" value="true"/>"#;
+    // Stretched along its axis: longer, as round as before.
+    let c = get("b.xml", cylinder(body, r#"<scale x="1" y="1" z="2"/>"#)).unwrap();
+    assert!(close(c.p0, Vec3::new(1.0, 0.0, 0.0)) && close(c.p1(), Vec3::new(1.0, 0.0, 6.0)), "{c:?}");
+    assert!((c.radius - 0.5).abs() < 1e-6 && c.flip);
+    // Hit from the camera's side, its flipped normal towards the axis.
+    let ray = photonmap::math::Ray::new(Vec3::new(3.0, 0.0, 2.0), -Vec3::X);
+    let h = Shape::Cylinder(c).intersect(&ray, f32::INFINITY, None).unwrap();
+    assert!((h.t - 1.5).abs() < 1e-5 && close(h.normal, -Vec3::X), "{h:?}");
+    // Stretched across its axis, or mirrored: refused at the shape.
+    let e = get("c.xml", cylinder(body, r#"<scale x="2" y="1" z="1"/>"#)).unwrap_err();
+    assert!(e.contains("c.xml:7:1") && e.contains("elliptic"), "{e}");
+    let e = get("d.xml", cylinder(body, r#"<scale x="-1" y="1" z="1"/>"#)).unwrap_err();
+    assert!(e.contains("d.xml:7:1") && e.contains("mirroring"), "{e}");
+    let e = get("e.xml", cylinder(r#"<point name="p1" x="0" y="0" z="0"/>"#, "")).unwrap_err();
+    assert!(e.contains("e.xml:7:1") && e.contains("p1"), "{e}");
+}
