@@ -464,3 +464,48 @@ fn cylinders_follow_p0_p1_radius_and_to_world() {
     let e = get("e.xml", cylinder(r#"<point name="p1" x="0" y="0" z="0"/>"#, "")).unwrap_err();
     assert!(e.contains("e.xml:7:1") && e.contains("p1"), "{e}");
 }
+
+/// A diffuse cylinder under a directional light, seen from above its
+/// crest: L = rho E cos / pi, the cosine that of the tube's normal; no
+/// shadow ray leaving the tube meets it again. Flipped, the camera sees
+/// its back: black, as Mitsuba's one-sided diffuse is there.
+#[test]
+fn a_lit_cylinder_shades_by_its_normal() {
+    let dir = scratch_dir("mitsuba_cylinder_render");
+    let light = r#"<emitter type="directional"><vector name="direction" value="0,0,-1"/><rgb name="irradiance" value="2"/></emitter>"#;
+    let tube = |flip: bool| {
+        format!(
+            r#"<shape type="cylinder"><point name="p0" x="-10" y="0" z="0"/><point name="p1" x="10" y="0" z="0"/>
+                 <boolean name="flip_normals" value="{flip}"/>{DIFFUSE}</shape>"#
+        )
+    };
+    let f = write(
+        &dir,
+        "lit.xml",
+        &plane_scene("", DIFFUSE, light, "direct")
+            .replace("<shape type=\"rectangle\"", &format!("{}<shape type=\"rectangle\"", tube(false))),
+    );
+    let parts = read(&f, &[]).unwrap().file.parts;
+    let film = render(parts, 16);
+    // Row y of 16 sees the crest at height 1 from 1 away, 40 degrees across:
+    // the tube's normal at the hit has cos = z / 1.
+    let half = (20f64.to_radians()).tan();
+    for y in [6, 7, 8, 9, 4] {
+        let v = ((y as f64 + 0.5) / 16.0 * 2.0 - 1.0) * half;
+        // The view ray (0, v, -1) from (0, 0, 2) meets y^2 + z^2 = 1.
+        let (a, b, c) = (1.0 + v * v, -4.0, 3.0);
+        let t = (-b - (b * b - 4.0 * a * c).sqrt()) / (2.0 * a);
+        let z = 2.0 - t;
+        let want = 0.6 * 2.0 / std::f64::consts::PI * z;
+        let got = (0..16).map(|x| film.get(x, y).x as f64).sum::<f64>() / 16.0;
+        assert!((got - want).abs() < 0.01 * want, "row {y}: {got} vs {want}");
+    }
+    let f = write(
+        &dir,
+        "flipped.xml",
+        &plane_scene("", DIFFUSE, light, "direct")
+            .replace("<shape type=\"rectangle\"", &format!("{}<shape type=\"rectangle\"", tube(true))),
+    );
+    let film = render(read(&f, &[]).unwrap().file.parts, 4);
+    assert_eq!(film.get(8, 8).x, 0.0);
+}
