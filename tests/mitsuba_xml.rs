@@ -509,3 +509,26 @@ fn a_lit_cylinder_shades_by_its_normal() {
     let film = render(read(&f, &[]).unwrap().file.parts, 4);
     assert_eq!(film.get(8, 8).x, 0.0);
 }
+
+/// A cylinder read, exported for Mitsuba and read back is the same tube.
+#[test]
+fn cylinders_survive_the_export() {
+    use photonmap::export::mitsuba::{to_mitsuba, Placement};
+    let dir = scratch_dir("mitsuba_cylinder_export");
+    let text = scene(
+        r#"<shape type="cylinder"><point name="p0" x="1" y="2" z="3"/><point name="p1" x="-1" y="0" z="6"/>
+             <float name="radius" value="0.25"/><boolean name="flip_normals" value="true"/></shape>"#,
+    );
+    let parts = read(&write(&dir, "in.xml", &text), &[]).unwrap().file.parts;
+    let out = to_mitsuba(&parts, None, "m", Placement::new(Vec3::ZERO, 1.0).unwrap()).unwrap();
+    let back = read(&write(&dir, "out.xml", &out.xml), &[]).unwrap().file.parts;
+    let cylinders = |p: &SceneParts| {
+        p.prims.iter().filter_map(|p| if let Shape::Cylinder(c) = p.shape { Some(c) } else { None }).collect::<Vec<_>>()
+    };
+    let (a, b) = (cylinders(&parts), cylinders(&back));
+    assert_eq!(a.len(), 1);
+    assert_eq!(b.len(), 1);
+    let (a, b) = (a[0], b[0]);
+    assert!((a.p0 - b.p0).length() < 1e-5 && (a.p1() - b.p1()).length() < 1e-5, "{a:?} {b:?}");
+    assert!((a.radius - b.radius).abs() < 1e-6 && a.flip && b.flip);
+}
