@@ -5,14 +5,14 @@
 use glam::{DVec3, Vec3};
 use photonmap::film::Film;
 use photonmap::material::Material;
-use photonmap::math::{Color, Ray};
+use photonmap::math::{offset_ray_origin, Color, Ray};
 use photonmap::metrics::compare;
 use photonmap::progress::Mode;
 use photonmap::render::render;
 use photonmap::sampling::{next_2d, stream, Domain};
 use photonmap::scene::{Eye, LightSpec, Prim, Scene, SceneParts};
 use photonmap::settings::Settings;
-use photonmap::shape::{Shape, Sphere, Triangle};
+use photonmap::shape::{Cylinder, Shape, Sphere, Triangle};
 use proptest::prelude::*;
 
 fn inside_room(p: Vec3) -> bool {
@@ -225,6 +225,112 @@ proptest! {
             }
         } else if disc < -1e-3 * (radius as f64).powi(2) {
             prop_assert!(hit.is_none());
+        }
+    }
+}
+
+/// The f64 roots of a line against the exact cylinder the f32 data
+/// define, and the f64 distance of a point from its axis.
+struct ExactCylinder {
+    p0: DVec3,
+    a: DVec3,
+    r: f64,
+}
+
+impl ExactCylinder {
+    fn of(c: &Cylinder) -> Self {
+        ExactCylinder { p0: c.p0.as_dvec3(), a: c.axis.as_dvec3().normalize(), r: c.radius as f64 }
+    }
+
+    fn roots(&self, o: DVec3, d: DVec3) -> Option<(f64, f64)> {
+        let oc = (o - self.p0).reject_from_normalized(self.a);
+        let dp = d.reject_from_normalized(self.a);
+        let (aa, b, c) = (dp.length_squared(), oc.dot(dp), oc.length_squared() - self.r * self.r);
+        let disc = b * b - aa * c;
+        (aa > 0.0 && disc >= 0.0).then(|| ((-b - disc.sqrt()) / aa, (-b + disc.sqrt()) / aa))
+    }
+
+    fn axis_distance(&self, p: DVec3) -> f64 {
+        (p - self.p0).reject_from_normalized(self.a).length()
+    }
+
+    fn height(&self, p: DVec3) -> f64 {
+        (p - self.p0).dot(self.a)
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2000, ..ProptestConfig::default() })]
+
+    /// Cylinders across magnitudes 1e-4..1e5, placed 1e-3..1e5 from the
+    /// origin, met from outside and inside: the hit agrees with the f64
+    /// roots, its point lies within its error bound of the exact surface,
+    /// and rays spawned from it on either side never meet the surface they
+    /// leave again, even without the departure rules.
+    #[test]
+    fn cylinder_hits_match_an_f64_reference(
+        exp in -4.0f64..5.0,
+        center_exp in -3.0f64..5.0,
+        center in vec_in(1.0),
+        o in vec_in(3.0),
+        axis in vec_in(1.0),
+        r in 0.1f64..1.5,
+        len in 0.2f64..3.0,
+        aim in (0.0f64..1.0, 0.0f64..std::f64::consts::TAU),
+        turn in vec_in(1.0),
+    ) {
+        let s = 10f64.powf(exp);
+        let center = (center.as_dvec3() * 10f64.powf(center_exp)).as_vec3();
+        let Some(axis) = axis.try_normalize() else { return Ok(()) };
+        let p0 = center - (axis.as_dvec3() * (0.5 * len * s)).as_vec3();
+        let p1 = p0 + (axis.as_dvec3() * (len * s)).as_vec3();
+        let Some(cyl) = Cylinder::new(p0, p1, (r * s) as f32, false) else { return Ok(()) };
+        let exact = ExactCylinder::of(&cyl);
+        let origin = center + (o.as_dvec3() * s).as_vec3();
+        // Aimed at a point of the tube, so that most rays hit.
+        let frame = photonmap::math::Frame::from_normal(axis);
+        let radial = frame.s.as_dvec3() * aim.1.cos() + frame.t.as_dvec3() * aim.1.sin();
+        let target = exact.p0 + exact.a * (aim.0 * cyl.length as f64) + radial * exact.r;
+        let Some(dir) = (target - origin.as_dvec3()).as_vec3().try_normalize() else { return Ok(()) };
+        let hit = cyl.intersect(&Ray::new(origin, dir), f32::INFINITY, None);
+        let scale = s + center.abs().max_element() as f64;
+        let (od, dd) = (origin.as_dvec3(), dir.as_dvec3());
+        let len64 = cyl.length as f64;
+        // Roots well inside the tube's length and clear of the origin.
+        let clear = |t: f64| t > 1e-3 * s && (1e-3 * s..len64 - 1e-3 * s).contains(&exact.height(od + t * dd));
+        let Some((t0, t1)) = exact.roots(od, dd) else {
+            prop_assert!(hit.is_none() || exact.roots(od, dd).is_some());
+            return Ok(());
+        };
+        let t64 = if t0 > 0.0 { t0 } else { t1 };
+        let sure = (t1 - t0) > 1e-3 * s && clear(t64) && (t0 <= 0.0 || clear(t0));
+        if !sure {
+            return Ok(());
+        }
+        prop_assert!(hit.is_some(), "missed at t64 {t64}");
+        let h = hit.unwrap();
+        prop_assert!((h.t as f64 - t64).abs() <= 2e-3 * s + 1e-5 * scale, "t {} vs {t64}", h.t);
+        let off = (exact.axis_distance(h.point.as_dvec3()) - exact.r).abs();
+        let bound = h.normal.abs().dot(h.p_err) as f64 + 2.0 * f32::EPSILON as f64 * scale;
+        prop_assert!(off <= bound, "off surface by {off} > {bound}");
+        // Spawned rays, away from the axis and towards it, where the tube is
+        // wider than the rounding of its position (a thinner one is crossed
+        // by a single ulp, and no origin lies inside it).
+        let resolved = exact.r > 1e4 * f32::EPSILON as f64 * scale;
+        for side in [1.0f32, -1.0].into_iter().filter(|_| resolved) {
+            let Some(out) = (h.normal * side + turn * 0.9).try_normalize() else { continue };
+            if out.dot(h.normal) * side < 0.1 {
+                continue;
+            }
+            let from = offset_ray_origin(h.point, h.p_err, h.normal, out);
+            let away = exact.axis_distance(from.as_dvec3()) > exact.r;
+            prop_assert_eq!(away, side > 0.0, "the spawned origin is on the wrong side");
+            let again = cyl.intersect(&Ray::new(from, out), f32::INFINITY, None);
+            if side > 0.0 {
+                prop_assert!(again.is_none(), "left outwards, met again at {:?}", again.map(|a| a.t));
+            } else if let Some(a) = again {
+                prop_assert!(a.t as f64 > 0.05 * exact.r, "left inwards, met again at {} (radius {})", a.t, exact.r);
+            }
         }
     }
 }

@@ -179,6 +179,14 @@ pub fn to_mitsuba(
                 refs(p.material)
             ),
             Shape::Ellipsoid(e) => out.ellipsoid(&e, &refs(p.material)),
+            Shape::Cylinder(c) => format!(
+                "    <shape type=\"cylinder\">\n        <point name=\"p0\" value=\"{}\"/>\n        <point name=\"p1\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{}\"/>\n        <boolean name=\"flip_normals\" value=\"{}\"/>\n{}    </shape>\n",
+                xyz(at(c.p0)),
+                xyz(at(c.p1())),
+                c.radius * s,
+                c.flip,
+                refs(p.material)
+            ),
             Shape::Triangle(_) => unreachable!("handled above"),
         };
     }

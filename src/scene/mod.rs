@@ -15,10 +15,11 @@ pub mod mitsuba;
 pub mod ply;
 pub mod procedural;
 mod room;
+pub mod serialized;
 
 pub use room::{tncg15_room, Eye};
 
-use crate::shape::{Departure, Disk, Ellipsoid, Shape, ShapeHit, Sphere, Triangle};
+use crate::shape::{Cylinder, Departure, Disk, Ellipsoid, Shape, ShapeHit, Sphere, Triangle};
 use glam::{Vec2, Vec3};
 
 /// One primitive: its geometry, the index of its material, and the object
@@ -262,6 +263,9 @@ impl SceneParts {
                 Shape::Ellipsoid(e) => Shape::Ellipsoid(
                     Ellipsoid::new(glam::Affine3A::from_scale(Vec3::splat(s)) * e.to_world()).unwrap_or(e),
                 ),
+                Shape::Cylinder(c) => {
+                    Shape::Cylinder(Cylinder { p0: c.p0 * s, length: c.length * s, radius: c.radius * s, ..c })
+                }
             };
         }
         for l in &mut self.lights {

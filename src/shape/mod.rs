@@ -1,5 +1,6 @@
 //! The course's shapes: triangles (Möller–Trumbore), spheres (analytic, both
-//! roots), disks, and tetrahedra as four triangles.
+//! roots), disks, and tetrahedra as four triangles; ellipsoids and Mitsuba's
+//! open cylinders.
 //!
 //! Every intersection returns the hit point together with a bound on its
 //! rounding error, which [`crate::math::offset_ray_origin`] turns into a safe
@@ -10,11 +11,13 @@
 //! rules replace the "ignore hits closer than epsilon" habit, which also
 //! ignores genuinely close surfaces.
 
+mod cylinder;
 mod disk;
 mod ellipsoid;
 mod sphere;
 mod triangle;
 
+pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use ellipsoid::Ellipsoid;
 pub use sphere::Sphere;
@@ -54,6 +57,7 @@ pub enum Shape {
     Sphere(Sphere),
     Disk(Disk),
     Ellipsoid(Ellipsoid),
+    Cylinder(Cylinder),
 }
 
 impl Shape {
@@ -84,6 +88,7 @@ impl Shape {
             Shape::Disk(disk) => disk.distance(ray, t_max).map(|t| (t, [0.0; 2])),
             Shape::Sphere(s) => s.distance(ray, t_max, departed).map(|t| (t, [0.0; 2])),
             Shape::Ellipsoid(e) => e.distance(ray, t_max, departed).map(|t| (t, [0.0; 2])),
+            Shape::Cylinder(c) => c.distance(ray, t_max, departed).map(|t| (t, [0.0; 2])),
         }
     }
 
@@ -94,6 +99,7 @@ impl Shape {
             Shape::Disk(disk) => disk.record(ray, t),
             Shape::Sphere(s) => s.record(ray, t),
             Shape::Ellipsoid(e) => e.record(ray, t),
+            Shape::Cylinder(c) => c.record(ray, t),
         }
     }
 
@@ -111,6 +117,7 @@ impl Shape {
                 let (lo, hi) = e.bounds();
                 (Vec3::from(e.to_world().translation), ((hi - lo) * 0.5).length())
             }
+            Shape::Cylinder(c) => c.bounding_sphere(),
         }
     }
 
@@ -129,6 +136,7 @@ impl Shape {
                 Vec3::from(e.to_world().translation).dot(u),
                 (e.to_world().matrix3.transpose() * glam::Vec3A::from(u)).length(),
             ),
+            Shape::Cylinder(c) => return c.extent_along(u),
         };
         (c - half, c + half)
     }
@@ -144,6 +152,7 @@ impl Shape {
                 (d.center - e, d.center + e)
             }
             Shape::Ellipsoid(e) => e.bounds(),
+            Shape::Cylinder(c) => c.bounds(),
         }
     }
 }

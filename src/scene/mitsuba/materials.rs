@@ -157,7 +157,7 @@ fn ior(p: &Plugin, name: &str, default: &str) -> Result<f64, SceneError> {
 }
 
 /// A conductor's complex index: `eta` and `k`, or a named `material`
-/// ('none': a perfect mirror, eta 0 + 1i).
+/// (conductors.rs; 'none': a perfect mirror, eta 0 + 1i).
 fn complex_ior(p: &Plugin) -> Result<(Color, Color), SceneError> {
     let eta = p.color("eta", Use::Unbounded)?;
     let k = p.color("k", Use::Unbounded)?;
@@ -166,11 +166,9 @@ fn complex_ior(p: &Plugin) -> Result<(Color, Color), SceneError> {
         (Some((m, loc)), Some(_), _) | (Some((m, loc)), _, Some(_)) if m != "none" => {
             Err(p.fail(&loc, "material", format!("give either eta and k or a material ('{m}'), not both")))
         }
-        (Some((m, loc)), None, None) if m != "none" => Err(p.fail(
-            &loc,
-            "material",
-            format!("the named conductor '{m}' is not supported yet; give eta and k (or 'none', a perfect mirror)"),
-        )),
+        (Some((m, loc)), None, None) if m != "none" => super::conductors::named_conductor(&m).ok_or_else(|| {
+            p.fail(&loc, "material", format!("'{m}' is not a conductor Mitsuba names (e.g. Au, Ag, Al, Cu, Cr)"))
+        }),
         (_, eta, k) => Ok((eta.unwrap_or(Color::ZERO), k.unwrap_or(Color::ONE))),
     }
 }

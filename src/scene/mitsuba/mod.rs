@@ -18,6 +18,7 @@
 //! [`Imported::substitutions`].
 
 pub mod cie;
+pub mod conductors;
 mod emitters;
 mod materials;
 pub mod props;

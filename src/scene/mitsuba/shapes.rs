@@ -2,7 +2,9 @@
 //! instance's), with its BSDF and, for an area emitter, a light per
 //! triangle. Mitsuba's shapes in their own frames (src/shapes/*.cpp):
 //! `rectangle` is [-1, 1]^2 at z = 0 facing +z, `cube` is [-1, 1]^3,
-//! `disk` the unit disk facing +z, `sphere` a `center` and `radius`.
+//! `disk` the unit disk facing +z, `sphere` a `center` and `radius`,
+//! `cylinder` an open tube of `radius` from `p0` to `p1`, its normals away
+//! from the axis.
 //!
 //! Meshes keep their vertex normals; a mesh without them gets
 //! angle-weighted vertex normals (Thürmer and Wüthrich 1998), as Mitsuba
@@ -17,8 +19,9 @@ use crate::math::Color;
 use crate::scene::file::SceneError;
 use crate::scene::mesh::load_obj;
 use crate::scene::ply::load_ply;
+use crate::scene::serialized::load_serialized;
 use crate::scene::{LightSpec, Prim};
-use crate::shape::{Disk, Ellipsoid, Shape, Sphere, Triangle};
+use crate::shape::{Cylinder, Disk, Ellipsoid, Shape, Sphere, Triangle};
 use glam::{Affine3A, DAffine3, DVec3, Vec3};
 use std::collections::HashMap;
 
@@ -55,7 +58,7 @@ impl Builder<'_> {
             }
             _ => {}
         }
-        for medium in p.objects("medium")? {
+        if let Some(medium) = p.objects("medium")?.first() {
             return Err(medium.refuse("participating media are not supported yet"));
         }
         let bsdf = p.object("bsdf")?;
@@ -80,7 +83,7 @@ impl Builder<'_> {
         }
         let object = self.new_object();
         let mesh = match p.kind {
-            "obj" | "ply" => {
+            "obj" | "ply" | "serialized" => {
                 let face_normals = p.boolean("face_normals", false)?;
                 let (name, loc) = p.string("filename")?.ok_or_else(|| p.refuse("needs a filename"))?;
                 let path = self.resolve(&name, &loc)?;
@@ -90,7 +93,16 @@ impl Builder<'_> {
                     let m = load_obj(&path).map_err(|e| p.fail(&loc, "filename", e))?;
                     (m.triangles, m.normals, None)
                 } else {
-                    let m = load_ply(&path).map_err(|e| p.fail(&loc, "filename", e))?;
+                    let m = if p.kind == "ply" {
+                        load_ply(&path).map_err(|e| p.fail(&loc, "filename", e))?
+                    } else {
+                        // The file's own face-normal flag is not read: Mitsuba 3
+                        // takes the parameter alone (serialized.cpp, load_legacy).
+                        let index = p.integer("shape_index")?.unwrap_or(0);
+                        let index = u32::try_from(index)
+                            .map_err(|_| p.fail(p.loc(), "shape_index", format!("must be 0 or more, got {index}")))?;
+                        load_serialized(&path, index).map_err(|e| p.fail(&loc, "filename", e))?.mesh
+                    };
                     let tris: Vec<[Vec3; 3]> = m.triangles.iter().map(|t| t.map(|i| m.positions[i as usize])).collect();
                     let normals = m.normals.as_ref().map(|n| m.triangles.iter().map(|t| t.map(|i| n[i as usize])).collect());
                     (tris, normals, Some(m.triangles.clone()))
@@ -121,6 +133,29 @@ impl Builder<'_> {
                     ),
                 })
             }
+            "cylinder" => {
+                let p0 = p.point("p0")?.unwrap_or(DVec3::ZERO);
+                let p1 = p.point("p1")?.unwrap_or(DVec3::Z);
+                let radius = p.float_in("radius", 1.0, 0.0, 1e15)?;
+                let m = cylinder_frame(p0, p1, radius).map(|f| to_world * f).ok_or_else(|| {
+                    p.fail(p.loc(), "p1", "the cylinder needs p1 apart from p0 and a radius above 0")
+                })?;
+                if m.matrix3.determinant() < 0.0 {
+                    return Err(p.fail(p.loc(), "to_world", "a mirroring transform is not supported for a cylinder"));
+                }
+                let [x, y, z] = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis];
+                let tol = 1e-6 * x.length();
+                if (x.length() - y.length()).abs() > tol || x.dot(y).abs() > tol * x.length() {
+                    return Err(p.fail(p.loc(), "to_world", "a cylinder stretched into an elliptic one is not supported"));
+                }
+                if x.dot(z).abs() + y.dot(z).abs() > tol * z.length() {
+                    return Err(p.fail(p.loc(), "to_world", "a sheared cylinder is not supported"));
+                }
+                let (a, b) = (m.translation.as_vec3(), m.transform_point3(DVec3::Z).as_vec3());
+                let c = Cylinder::new(a, b, x.length() as f32, flip)
+                    .ok_or_else(|| p.fail(p.loc(), "to_world", "the cylinder is empty or not finite in world space"))?;
+                Mesh::Analytic(Shape::Cylinder(c))
+            }
             "disk" => {
                 if flip {
                     return Err(p.fail(p.loc(), "flip_normals", "a disk with flipped normals is not supported yet"));
@@ -133,11 +168,11 @@ impl Builder<'_> {
             }
             k => {
                 return Err(p.refuse(format!(
-                    "the '{k}' shape is not supported yet (obj, ply, rectangle, cube, sphere, disk, shapegroup, instance are)"
+                    "the '{k}' shape is not supported yet (obj, ply, serialized, rectangle, cube, sphere, cylinder, disk, shapegroup, instance are)"
                 )))
             }
         };
-        p.finish("filename, face_normals, flip_normals, flip_tex_coords, to_world, center, radius, bsdf, emitter")?;
+        p.finish("filename, shape_index, face_normals, flip_normals, flip_tex_coords, to_world, center, radius, p0, p1, bsdf, emitter")?;
         match mesh {
             Mesh::Analytic(shape) => match (radiance, shape) {
                 (None, shape) => self.prims.push(Prim { shape, material, object }),
@@ -145,9 +180,10 @@ impl Builder<'_> {
                     self.lights.push(LightSpec::Area { surface: Emitting::Disk(d), radiance, material: Some(material) })
                 }
                 (Some(_), _) => {
-                    return Err(
-                        p.refuse("an emitting sphere is not supported yet (emitting meshes, rectangles and disks are)")
-                    )
+                    return Err(p.refuse(format!(
+                        "an emitting {} is not supported yet (emitting meshes, rectangles and disks are)",
+                        p.kind
+                    )))
                 }
             },
             Mesh::Tris(t) => self.push_triangles(t, &to_world, flip, material, object, radiance),
@@ -222,6 +258,19 @@ fn similarity(m: &DAffine3) -> Option<f64> {
         && x.dot(z).abs() <= tol * s
         && y.dot(z).abs() <= tol * s;
     (fits && s > 0.0).then_some(s)
+}
+
+/// Mitsuba's cylinder frame (cylinder.cpp): the unit-radius, unit-length
+/// tube along z carried to the segment p0-p1 with the given radius; `None`
+/// for an empty segment or radius. The choice of the frame's x and y is
+/// free: the tube is round.
+fn cylinder_frame(p0: DVec3, p1: DVec3, radius: f64) -> Option<DAffine3> {
+    let d = p1 - p0;
+    let length = d.length();
+    let axis = d.try_normalize().filter(|_| radius > 0.0 && length.is_finite())?;
+    let x = axis.any_orthonormal_vector();
+    let y = axis.cross(x);
+    Some(DAffine3::from_cols(x * radius, y * radius, d, p0))
 }
 
 fn affine(m: &DAffine3) -> Affine3A {
