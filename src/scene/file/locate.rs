@@ -104,3 +104,29 @@ fn field_path(path: &serde_path_to_error::Path) -> String {
         out
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The line and column as counted from the file's start, the way the
+    /// index must answer.
+    fn counted(text: &str, offset: usize) -> (usize, usize) {
+        let before = &text[..offset];
+        (before.matches('\n').count() + 1, before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1)
+    }
+
+    #[test]
+    fn the_line_index_answers_as_counting_from_the_start() {
+        let text = "[camera]\neye = [0, 0, 1]\n\n# caf\u{e9} \u{2014} \r\n[[shapes]]\ntype = \"sphere\"\n\nlast";
+        let starts = line_starts(text);
+        let src = Source { path: Path::new("s.toml"), text, line_starts: &starts };
+        for offset in (0..=text.len()).filter(|&i| text.is_char_boundary(i)) {
+            assert_eq!(src.line_column(offset), counted(text, offset), "offset {offset}");
+        }
+        // Past the end: the end.
+        assert_eq!(src.line_column(text.len() + 10), counted(text, text.len()));
+        let empty = Source { path: Path::new("e.toml"), text: "", line_starts: &line_starts("") };
+        assert_eq!(empty.line_column(0), (1, 1));
+    }
+}
