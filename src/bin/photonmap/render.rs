@@ -499,10 +499,6 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
 /// The progressive plan: where to start, when to stop.
 fn plan(cli: &RenderArgs, manifest: &Manifest, resumed: Option<Partial>, windows: Vec<Window>) -> Result<Plan, Error> {
     let mut budget = Budget { end: cli.passes, seconds: cli.time, target_error: cli.target_error, windows };
-    if budget.end.is_none() && budget.seconds.is_none() && budget.target_error.is_none() {
-        let what = if cli.resume.is_some() { "--resume" } else { "a progressive render" };
-        return Err(Error::Invalid(format!("{what} needs --passes, --time or --target-error to end it")));
-    }
     // A target too small to reach would run forever: a week is the
     // longest run, as for --time (said when a prediction shows it).
     if budget.target_error.is_some() && budget.seconds.is_none() {
@@ -527,6 +523,10 @@ fn plan(cli: &RenderArgs, manifest: &Manifest, resumed: Option<Partial>, windows
         budget.end = end;
         let start = Accumulation::new(manifest.width, manifest.height);
         return Ok(Plan { start, first, budget, parts: Vec::new() });
+    }
+    if budget.end.is_none() && budget.seconds.is_none() && budget.target_error.is_none() {
+        let what = if cli.resume.is_some() { "--resume" } else { "a progressive render" };
+        return Err(Error::Invalid(format!("{what} needs --passes, --time or --target-error to end it")));
     }
     if let Some(p) = resumed {
         let path = cli.resume.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
