@@ -258,7 +258,7 @@ mod tests {
     #[test]
     fn differing_settings_are_named_field_by_field() {
         let a = Settings::default();
-        let b = Settings { photons: a.photons * 2, seed: 7, r_global: Some(0.5), ..a.clone() };
+        let b = Settings { photons: a.photons * 2, seed: 7, r_global: Some(0.5), ..a };
         let why = settings_differences(&settings_key(&a), &settings_key(&b));
         let want = format!(
             "photons {} against {}, seed {} against 7, r_global None against Some(0.5)",

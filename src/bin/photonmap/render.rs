@@ -73,7 +73,8 @@ pub struct RenderArgs {
     time: Option<f64>,
     /// Progressive rendering until the predicted relative RMSE (of every
     /// --window, or of the whole image) is below this (0.02: 2%); checked
-    /// from the fourth pass on. --time caps it.
+    /// from the fourth pass on. --time caps it, else a week (a prediction
+    /// beyond the cap is said).
     #[arg(long, value_name = "E", value_parser = parse_target)]
     target_error: Option<f64>,
     /// A rectangle of pixels whose predicted error is reported (and, with
@@ -92,9 +93,10 @@ pub struct RenderArgs {
     #[arg(long, value_name = "PART.exr")]
     partial: Option<PathBuf>,
     /// Go on with the progressive render in this partial (same scene and
-    /// settings), from the pass after its last; --passes counts the passes
-    /// in the image, --time this run's seconds. --partial may name the same
-    /// file: it is replaced, atomically, by the longer render.
+    /// settings), from the pass after its last, until --passes (counting the
+    /// passes in the image), --time (this run's seconds) or --target-error:
+    /// one is needed. --partial may name the same file: it is replaced,
+    /// atomically, by the longer render.
     #[arg(long, value_name = "PART.exr", conflicts_with = "pass_range")]
     resume: Option<PathBuf>,
     /// Write a heat map of the per-pixel predicted error (progressive).
