@@ -14,7 +14,7 @@ use std::path::Path;
 
 /// The name the built-in room's default view goes by, which a reference
 /// without provenance (the Mitsuba references) is taken to show.
-pub const DEFAULT_VIEW: &str = "built-in TNCG15 room, eye 1";
+const DEFAULT_VIEW: &str = "built-in TNCG15 room, eye 1";
 
 /// A reference must show the scene rendered: one whose header names its
 /// scene (photonmap's provenance) must name this one, else the scores

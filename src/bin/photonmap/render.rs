@@ -3,7 +3,7 @@
 //! passes, or on from a partial), writes, summarises.
 
 use crate::args::*;
-use crate::checks::{path_tracer_sees, reference_shows, threads_within_cores, TargetWatch, DEFAULT_VIEW, WEEK};
+use crate::checks::{path_tracer_sees, reference_shows, threads_within_cores, TargetWatch, WEEK};
 use crate::count::count;
 use crate::outputs::Outputs;
 use crate::summary::finish;
@@ -261,7 +261,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
     let (mut scene, file_spp, scene_id) = match &cli.scene {
         None => {
             let eye = if cli.eye == Some(2) { Eye::Two } else { Eye::One };
-            let name = if eye == Eye::Two { DEFAULT_VIEW.replace("eye 1", "eye 2") } else { DEFAULT_VIEW.into() };
+            let name = format!("built-in TNCG15 room, eye {}", if eye == Eye::Two { 2 } else { 1 });
             (Scene::tncg15(eye), 4, SceneId::built_in(&name))
         }
         Some(path) => {
