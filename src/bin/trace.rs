@@ -103,12 +103,6 @@ fn run(cli: Cli) -> Result<(), Error> {
     let mut scene = Scene::from_parts(file.parts);
     wait.finish();
     let load_time = start.elapsed();
-    if scene.lights.is_empty() && scene.ambient == Color::ZERO {
-        return Err(Error::Invalid(format!(
-            "{}: the scene has no light (a [[lights]] entry, an emissive shape or ambient), so its image is black",
-            cli.scene.display()
-        )));
-    }
     let (w, h) = (cli.width.unwrap_or(scene.camera.width), cli.height.unwrap_or(scene.camera.height));
     scene.camera = scene.camera.fit(w, h).map_err(|e| Error::Invalid(format!("{}: {e}", cli.scene.display())))?;
     let spp = cli.spp.unwrap_or(n * n);
@@ -119,6 +113,12 @@ fn run(cli: Cli) -> Result<(), Error> {
             "{}: a {w} x {h} image needs about {:.1} GB; less memory is available",
             cli.scene.display(),
             need as f64 / 1e9
+        )));
+    }
+    if scene.lights.is_empty() && scene.ambient == Color::ZERO {
+        return Err(Error::Invalid(format!(
+            "{}: the scene has no light (a [[lights]] entry, an emissive shape or ambient), so its image is black",
+            cli.scene.display()
         )));
     }
     let t = Instant::now();

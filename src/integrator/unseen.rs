@@ -34,8 +34,9 @@ pub fn specular_shares(scene: &Scene) -> Vec<SpecularShare> {
             let u = Vec2::new(((i % GRID) as f32 + 0.5) / GRID as f32, ((i / GRID) as f32 + 0.5) / GRID as f32);
             // The position's numbers run across the grid the other way, so
             // a directional light's rays cover its disk and directions alike.
-            let (ray, departure) = l.emit(Vec2::new(u.y, u.x), u);
-            if let Some(hit) = scene.intersect(&ray, departure) {
+            // Only where the ray goes counts, not what it carries.
+            let emitted = l.emit(Vec2::new(u.y, u.x), u);
+            if let Some(hit) = scene.intersect(&emitted.0, emitted.1) {
                 met += 1;
                 specular += scene.material(hit.prim).is_specular() as u32;
             }

@@ -47,7 +47,8 @@ fn describe(light: &Light) -> String {
     match light {
         Light::Point { position, .. } => format!("the point light at {position}"),
         Light::Directional { direction, .. } => format!("the directional light along {direction}"),
-        Light::Area(_) => "an area light".into(),
+        // Lights without a place to name (other delta lights).
+        _ => format!("a {} light", if light.is_delta() { "delta" } else { "surface" }),
     }
 }
 
