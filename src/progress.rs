@@ -68,6 +68,19 @@ impl Phase {
     }
 }
 
+/// Seconds more a progressive render needs to reach its `--target-error`
+/// (None: no target, or no prediction yet). Noise falls as the square root
+/// of the passes: the passes the worst region needs, from its error now, at
+/// the time per pass so far.
+pub fn seconds_to_target(budget: &Budget, r: &PassReport) -> Option<f64> {
+    let target = budget.target_error?;
+    let per_pass = r.elapsed.as_secs_f64() / r.rendered.max(1) as f64;
+    let worst = r.predictions.iter().skip((!budget.windows.is_empty()) as usize);
+    let e = worst.map(|(_, p)| p.relative_rmse()).reduce(f64::max)?;
+    let need = r.passes as f64 * (e / target).powi(2);
+    Some(per_pass * (need - r.passes as f64).max(0.0))
+}
+
 /// Progress of a progressive render: passes done, radii, predicted
 /// error, time left.
 pub struct PassDisplay {
@@ -108,14 +121,8 @@ impl PassDisplay {
         if let Some(s) = self.budget.seconds {
             take((s - elapsed).max(0.0));
         }
-        if let Some(target) = self.budget.target_error {
-            // Noise falls as the square root of the passes: the passes
-            // the worst region needs, from its error now.
-            let worst = r.predictions.iter().skip((!self.budget.windows.is_empty()) as usize);
-            if let Some(e) = worst.map(|(_, p)| p.relative_rmse()).reduce(f64::max) {
-                let need = r.passes as f64 * (e / target).powi(2);
-                take(per_pass * (need - r.passes as f64).max(0.0));
-            }
+        if let Some(more) = seconds_to_target(&self.budget, r) {
+            take(more);
         }
         left
     }
@@ -154,6 +161,45 @@ impl PassDisplay {
     pub fn finish(self) {
         if let Some(bar) = self.bar {
             bar.finish_and_clear();
+        }
+    }
+}
+
+/// A line for a wait of unknown length (loading a scene): said once the
+/// wait passes a second, so a long load is not silent, and closed with its
+/// time. Nothing is said for a short wait or with `--quiet`.
+pub struct Wait {
+    done: Option<std::sync::mpsc::Sender<()>>,
+    said: Option<std::thread::JoinHandle<bool>>,
+    start: std::time::Instant,
+    what: String,
+}
+
+impl Wait {
+    /// After this long a wait is said.
+    pub const AFTER: std::time::Duration = std::time::Duration::from_secs(1);
+
+    /// `what`: the wait's subject, e.g. "loading scenes/big.toml (9.2 MB)".
+    pub fn start(mode: Mode, what: String) -> Wait {
+        let (done, finished) = std::sync::mpsc::channel::<()>();
+        let line = what.clone();
+        let said = (mode != Mode::Quiet).then(|| {
+            std::thread::spawn(move || match finished.recv_timeout(Self::AFTER) {
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                    eprintln!("{line} ...");
+                    true
+                }
+                _ => false,
+            })
+        });
+        Wait { done: Some(done), said, start: std::time::Instant::now(), what }
+    }
+
+    /// Ends the wait; if it was said, says how long it took.
+    pub fn finish(mut self) {
+        self.done.take();
+        if self.said.take().is_some_and(|t| t.join().unwrap_or(false)) {
+            eprintln!("{}: done in {:.1} s", self.what, self.start.elapsed().as_secs_f64());
         }
     }
 }

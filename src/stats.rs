@@ -157,9 +157,9 @@ impl Summary<'_> {
             Method::Photon => "photon mapping",
             Method::Path => "path tracing",
         };
-        let passes = if s.passes == 1 { "1 pass".to_string() } else { format!("{} passes", s.passes) };
-        let mut out =
-            vec![format!("photonmap: {method}, {passes}, {} threads, {} x {}", self.threads, st.width, st.height)];
+        let (passes, threads) =
+            (counted(s.passes as u64, "pass", "passes"), counted(self.threads as u64, "thread", "threads"));
+        let mut out = vec![format!("photonmap: {method}, {passes}, {threads}, {} x {}", st.width, st.height)];
         out.push(format!("  scene load   {:>8.3} s", secs(self.load_time)));
         if st.method == Method::Photon {
             let last = if s.passes > 1 { " (last pass)" } else { "" };
@@ -257,4 +257,9 @@ impl Summary<'_> {
         out.push(format!("  total        {:>8.3} s", secs(self.total_time)));
         out
     }
+}
+
+/// `n` things, in the singular for one: "1 pass", "2 passes".
+pub fn counted(n: u64, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
 }

@@ -161,7 +161,7 @@ fn ctrl_c_in_a_progressive_render_keeps_the_passes() {
     let passes = header.attributes.iter().find(|(k, _)| k == "passes").map(|(_, v)| v.clone()).unwrap();
     let done: u32 = passes.trim_start_matches("0..").parse().unwrap();
     assert!(done >= 1, "passes {passes}");
-    assert!(stderr(&output).contains(&format!("{done} passes")), "{}", stderr(&output));
+    assert!(stderr(&output).contains(&format!("{done} pass")), "{}", stderr(&output));
     assert_eq!(image::open(&png).unwrap().to_rgb8().dimensions(), (48, 48));
     assert_eq!(files_in(&dir), ["progressive.exr", "progressive.png"]);
 }

@@ -45,6 +45,8 @@ const BROKEN: &[(&str, usize, usize, &str, &str)] = &[
     ("reflectance_over_one.toml", 15, 7, "materials.hot.rho", "at most 1"),
     ("zero_width.toml", 6, 9, "camera.width", "must be in [1, 65536], got 0"),
     ("two_vertices.toml", 15, 12, "shapes[0].vertices", "needs 3 vertices, got 2"),
+    ("zero_radiance.toml", 20, 8, "lights[0]", "emits no light (a colour of 0"),
+    ("tiny_disk_light.toml", 20, 8, "lights[0]", "nor does any other light, so the image would be black"),
 ];
 
 #[test]

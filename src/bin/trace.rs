@@ -6,14 +6,19 @@ use clap::Parser;
 use photonmap::error::Error;
 use photonmap::film::ToneMap;
 use photonmap::integrator::whitted::Whitted;
+use photonmap::math::Color;
 use photonmap::memory::available_memory;
 use photonmap::output::{check_writable, same_file, write_with, Extras};
-use photonmap::progress::Mode;
+use photonmap::progress::{Mode, Wait};
 use photonmap::provenance::SceneId;
 use photonmap::scene::Scene;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
+
+#[path = "photonmap/count.rs"]
+mod count;
+use count::count;
 
 /// Whitted ray tracer (CS475 A3): Phong shading, point and directional
 /// lights with shadows, transformed spheres, recursive reflection, jittered
@@ -27,22 +32,22 @@ struct Cli {
     /// .exr (linear float, with how it was made in its header).
     out: PathBuf,
     /// Bounce depth: reflections stop after this many (0: none).
-    #[arg(default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=1000))]
+    #[arg(default_value_t = 5, value_parser = count(0, 1000))]
     depth: u32,
     /// Image width in pixels [default: the scene file's]. A size of another
     /// shape than the camera's widens a look-at camera's view; a
     /// four-corner camera's plane must have the image's shape.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    #[arg(long, value_parser = count(1, 65_536))]
     width: Option<u32>,
     /// Image height in pixels [default: the scene file's].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    #[arg(long, value_parser = count(1, 65_536))]
     height: Option<u32>,
     /// Jittered samples per pixel (stratified when a square) [default:
     /// rays_per_pixel_edge squared from the scene file].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, value_parser = count(1, 1_000_000))]
     spp: Option<u32>,
     /// Worker threads [default: all cores].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    #[arg(long, value_parser = count(1, 4096))]
     threads: Option<u32>,
     /// Seed of the pixel jitter.
     #[arg(long, default_value_t = 1, value_parser = parse_seed)]
@@ -57,7 +62,8 @@ fn parse_seed(s: &str) -> Result<u64, String> {
 }
 
 fn main() -> ExitCode {
-    // Ctrl-C stops at once, and leaves no half-written file behind.
+    // Ctrl-C, SIGTERM or SIGHUP (the ctrlc crate's `termination` feature)
+    // stops at once, and leaves no half-written file behind.
     let _ = ctrlc::set_handler(|| {
         photonmap::output::remove_temporaries();
         std::process::exit(130);
@@ -80,6 +86,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             .build_global()
             .map_err(|e| Error::Invalid(format!("--threads: {e}")))?;
     }
+    let size = std::fs::metadata(&cli.scene).map_or(String::new(), |m| format!(" ({:.1} MB)", m.len() as f64 / 1e6));
+    let wait = Wait::start(Mode::detect(cli.quiet), format!("trace: loading {}{size}", cli.scene.display()));
     let file = photonmap::scene::file::load(&cli.scene).map_err(|e| Error::Invalid(e.to_string()))?;
     let id =
         SceneId::from_files(&cli.scene, &file.meshes).map_err(|e| Error::Io { path: cli.scene.clone(), source: e })?;
@@ -93,6 +101,7 @@ fn run(cli: Cli) -> Result<(), Error> {
     }
     let n = file.rays_per_pixel_edge;
     let mut scene = Scene::from_parts(file.parts);
+    wait.finish();
     let load_time = start.elapsed();
     let (w, h) = (cli.width.unwrap_or(scene.camera.width), cli.height.unwrap_or(scene.camera.height));
     scene.camera = scene.camera.fit(w, h).map_err(|e| Error::Invalid(format!("{}: {e}", cli.scene.display())))?;
@@ -104,6 +113,12 @@ fn run(cli: Cli) -> Result<(), Error> {
             "{}: a {w} x {h} image needs about {:.1} GB; less memory is available",
             cli.scene.display(),
             need as f64 / 1e9
+        )));
+    }
+    if scene.lights.is_empty() && scene.ambient == Color::ZERO {
+        return Err(Error::Invalid(format!(
+            "{}: the scene has no light (a [[lights]] entry, an emissive shape or ambient), so its image is black",
+            cli.scene.display()
         )));
     }
     let t = Instant::now();
@@ -126,7 +141,8 @@ fn run(cli: Cli) -> Result<(), Error> {
     let write_time = t.elapsed();
     if !cli.quiet {
         let threads = rayon::current_num_threads();
-        eprintln!("trace: Whitted, {w} x {h}, {spp} spp, depth {}, {threads} threads", cli.depth);
+        let threads = photonmap::stats::counted(threads as u64, "thread", "threads");
+        eprintln!("trace: Whitted, {w} x {h}, {spp} spp, depth {}, {threads}", cli.depth);
         eprintln!(
             "  scene load   {:>8.3} s  {} primitives, {} lights",
             load_time.as_secs_f64(),

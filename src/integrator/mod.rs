@@ -2,7 +2,8 @@
 //!
 //! * [`photon`]: Jensen's photon-mapping estimator (classic and progressive);
 //! * [`path`]: path tracing with next-event estimation, the unbiased reference;
-//! * [`whitted`]: the CS475 Whitted ray tracer.
+//! * [`whitted`]: the CS475 Whitted ray tracer;
+//! * [`unseen`]: what of a scene's light a path tracer cannot find.
 //!
 //! All run on the same camera pass (`render::camera_pass`), which owns the
 //! pixel loop and the random streams; an integrator answers one camera ray
@@ -13,6 +14,7 @@ mod aim;
 mod direct;
 pub mod path;
 pub mod photon;
+pub mod unseen;
 pub mod whitted;
 
 pub use direct::{direct_irradiance, direct_light, direct_light_one_at_a_time};

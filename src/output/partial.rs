@@ -70,11 +70,64 @@ impl Manifest {
                 &format!("{}x{}", other.width, other.height),
             );
         }
-        if self.settings != other.settings || self.method != other.method || self.alpha != other.alpha {
-            return differs("the settings", &self.settings, &other.settings);
+        if self.method != other.method {
+            return differs("the integrators", &self.method, &other.method);
+        }
+        if self.alpha != other.alpha {
+            return differs("the alphas", &self.alpha, &other.alpha);
+        }
+        if self.settings != other.settings {
+            return Some(format!("the settings differ: {}", settings_differences(&self.settings, &other.settings)));
         }
         None
     }
+}
+
+/// The fields in which two settings keys (`Settings { photons: 1000, seed:
+/// 1, .. }`) differ, as `photons 1000 against 2000, seed 1 against 2`: a
+/// reader is not left to find them in two long lines.
+fn settings_differences(a: &str, b: &str) -> String {
+    let (fa, fb) = (key_fields(a), key_fields(b));
+    let mut out: Vec<String> = fa
+        .iter()
+        .filter_map(|(name, va)| match fb.iter().find(|(n, _)| n == name) {
+            Some((_, vb)) if vb == va => None,
+            Some((_, vb)) => Some(format!("{name} {va} against {vb}")),
+            None => Some(format!("{name} {va} against none")),
+        })
+        .collect();
+    out.extend(
+        fb.iter().filter(|(n, _)| !fa.iter().any(|(m, _)| m == n)).map(|(n, v)| format!("{n} none against {v}")),
+    );
+    if out.is_empty() {
+        // Not a key of fields: the two in full.
+        return format!("{a} against {b}");
+    }
+    out.join(", ")
+}
+
+/// A settings key's `name: value` fields (commas inside brackets kept).
+fn key_fields(key: &str) -> Vec<(String, String)> {
+    let inner = key.find('{').zip(key.rfind('}')).map_or(key, |(i, j)| if i < j { &key[i + 1..j] } else { key });
+    let (mut fields, mut depth, mut start) = (Vec::new(), 0i32, 0usize);
+    let mut push = |part: &str| {
+        if let Some((name, value)) = part.split_once(':') {
+            fields.push((name.trim().to_string(), value.trim().to_string()));
+        }
+    };
+    for (i, c) in inner.char_indices() {
+        match c {
+            '(' | '[' | '{' => depth += 1,
+            ')' | ']' | '}' => depth -= 1,
+            ',' if depth == 0 => {
+                push(&inner[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    push(&inner[start..]);
+    fields
 }
 
 fn short(hash: &str) -> &str {
@@ -194,4 +247,24 @@ pub fn merge(parts: &[(String, Partial)], allow_gaps: bool) -> Result<Partial> {
     merged.manifest.parts.sort_by_key(|p| PassSet::parse(&p.passes).ok().and_then(|s| s.iter().next()));
     merged.manifest.passes = passes.to_string();
     Ok(merged)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::provenance::settings_key;
+    use crate::settings::Settings;
+
+    #[test]
+    fn differing_settings_are_named_field_by_field() {
+        let a = Settings::default();
+        let b = Settings { photons: a.photons * 2, seed: 7, r_global: Some(0.5), ..a };
+        let why = settings_differences(&settings_key(&a), &settings_key(&b));
+        let want = format!(
+            "photons {} against {}, seed {} against 7, r_global None against Some(0.5)",
+            a.photons, b.photons, a.seed
+        );
+        assert_eq!(why, want);
+        assert_eq!(settings_differences("x", "y"), "x against y");
+    }
 }

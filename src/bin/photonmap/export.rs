@@ -82,9 +82,31 @@ pub fn run(args: Args) -> Result<(), Error> {
     let exported = to_mitsuba(&parts, origins.as_ref(), &mesh_dir, placement)
         .map_err(|r| Error::Invalid(r.describe(origins.as_ref())))?;
     let dir = out.parent().filter(|p| !p.as_os_str().is_empty()).map(PathBuf::from).unwrap_or_else(|| ".".into());
+    // As for a render's outputs, a missing directory is a mistake to say,
+    // not one to make.
+    if !dir.is_dir() {
+        return Err(Error::Invalid(format!("{}: the directory {} does not exist", out.display(), dir.display())));
+    }
+    // The mesh files are named by the export, not by the user: one already
+    // there is replaced only by the same bytes (the same scene exported
+    // again), never by another scene's mesh.
+    for (name, bytes) in &exported.meshes {
+        let path = dir.join(name);
+        if path.exists() && std::fs::read(&path).ok().as_deref() != Some(bytes.as_slice()) {
+            return Err(Error::Invalid(format!(
+                "{}: a mesh file is already there, with other contents; it is not replaced (remove {} or \
+                 choose another name for {})",
+                path.display(),
+                dir.join(&mesh_dir).display(),
+                out.display()
+            )));
+        }
+    }
     if !exported.meshes.is_empty() {
         let meshes = dir.join(&mesh_dir);
-        std::fs::create_dir_all(&meshes).map_err(|e| Error::Io { path: meshes.clone(), source: e })?;
+        if !meshes.is_dir() {
+            std::fs::create_dir(&meshes).map_err(|e| Error::Io { path: meshes.clone(), source: e })?;
+        }
     }
     for (name, bytes) in &exported.meshes {
         write_bytes(&dir.join(name), bytes)?;

@@ -3,8 +3,8 @@
 //! partial render its manifest.
 
 use photonmap::error::Error;
-use photonmap::output::partial::Manifest;
-use photonmap::output::read_header;
+use photonmap::output::partial::{read_partial, Manifest};
+use photonmap::output::{read_exr, read_header};
 use std::path::PathBuf;
 
 /// Prints an EXR's size, channels and provenance (program, scene and its
@@ -17,6 +17,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<(), Error> {
+    let mut unreadable = Vec::new();
     for (i, path) in args.files.iter().enumerate() {
         let h = read_header(path)?;
         if i > 0 {
@@ -50,8 +51,21 @@ pub fn run(args: Args) -> Result<(), Error> {
                 Err(e) => println!("  manifest   unreadable: {e}"),
             }
         }
+        // The header comes first in the file: a file cut short (a copy
+        // interrupted, a full disk) has a whole header and missing pixels.
+        let pixels = match h.get("manifest") {
+            Some(_) => read_partial(path).map(|_| ()),
+            None => read_exr(path).map(|_| ()),
+        };
+        if let Err(e) = pixels {
+            println!("  pixels     unreadable, the file is truncated or damaged: {e}");
+            unreadable.push(path.display().to_string());
+        }
     }
-    Ok(())
+    match unreadable.is_empty() {
+        true => Ok(()),
+        false => Err(Error::Invalid(format!("the pixels of {} cannot be read", unreadable.join(", ")))),
+    }
 }
 
 /// Channel names grouped by their layer: "R G B, error.{R,G,B}, sums.{00..35}".

@@ -5,12 +5,15 @@
 //! panicked.
 
 mod args;
+mod checks;
 mod compare;
+mod count;
 mod export;
 mod info;
 mod merge;
 mod outputs;
 mod render;
+mod summary;
 mod write;
 
 use clap::{Parser, Subcommand};
@@ -45,11 +48,18 @@ enum Command {
     Info(info::Args),
 }
 
-/// Ctrl-C (SIGINT) or SIGTERM: the first asks the render to stop (a
-/// progressive render writes the passes it has and exits 130); a second
-/// exits at once, removing any file half-written.
+/// Ctrl-C (SIGINT), SIGTERM or SIGHUP (the ctrlc crate's `termination`
+/// feature): the first asks the render to stop (a progressive render writes
+/// the passes it has and exits 130); a second exits at once, removing any
+/// file half-written. Before rendering starts (loading the scene, the
+/// subcommands) there is nothing to keep, and the first exits at once.
 fn handle_signals() {
     let _ = ctrlc::set_handler(|| {
+        if !photonmap::interrupt::work_to_keep() {
+            photonmap::output::remove_temporaries();
+            eprintln!("\nphotonmap: interrupted (no half-written file is left)");
+            std::process::exit(130);
+        }
         if photonmap::interrupt::requested() {
             photonmap::output::remove_temporaries();
             std::process::exit(130);
@@ -59,8 +69,21 @@ fn handle_signals() {
     });
 }
 
+/// The command line, negative numbers taken as values in every subcommand
+/// as in rendering (`export --scale -1` is then refused for its value, not
+/// taken for a flag): clap's setting is per command.
+fn parse_cli() -> Cli {
+    use clap::{CommandFactory, FromArgMatches};
+    let mut command = Cli::command();
+    let names: Vec<String> = command.get_subcommands().map(|c| c.get_name().to_string()).collect();
+    for name in names {
+        command = command.mut_subcommand(name, |c| c.allow_negative_numbers(true));
+    }
+    Cli::from_arg_matches(&command.get_matches()).unwrap_or_else(|e| e.exit())
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = parse_cli();
     handle_signals();
     let result = match cli.command {
         Some(Command::Compare(args)) => compare::run(args),

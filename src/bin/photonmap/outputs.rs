@@ -3,7 +3,7 @@
 //! atomically, every one of them whatever happens to the others.
 
 use photonmap::error::Error;
-use photonmap::output::{check_writable, same_file};
+use photonmap::output::{check_writable, same_file, Format};
 use std::path::{Path, PathBuf};
 
 /// Every output of a run, by role.
@@ -26,11 +26,22 @@ impl Outputs {
         self.images.is_empty() && self.partial.is_none()
     }
 
-    /// Each output can be written and none is named twice.
+    /// Each output can be written, in a format its role can take, and none
+    /// is named twice.
     pub fn check_writable(&self) -> Result<(), Error> {
         let all = self.all();
         for (i, (role, path)) in all.iter().enumerate() {
-            check_writable(path)?;
+            let format = check_writable(path)?;
+            // Found here, not at the first write: a partial named .png was
+            // refused only after the passes it was to hold were rendered.
+            let wrong = match (*role, format) {
+                ("--partial", Format::Png | Format::Ppm) => Some("a partial render is an .exr file (exact sums)"),
+                ("--error-map", Format::Exr) => Some("the error map is an 8-bit picture: .png or .ppm"),
+                _ => None,
+            };
+            if let Some(why) = wrong {
+                return Err(Error::Invalid(format!("{role} {}: {why}", path.display())));
+            }
             if let Some((other, _)) = all[..i].iter().find(|(_, p)| same_file(p, path)) {
                 let roles =
                     if *other == *role { format!("twice as an {role}") } else { format!("as {other} and as {role}") };

@@ -3,25 +3,28 @@
 //! passes, or on from a partial), writes, summarises.
 
 use crate::args::*;
+use crate::checks::{path_tracer_sees, reference_shows, threads_within_cores, TargetWatch, WEEK};
+use crate::count::count;
 use crate::outputs::Outputs;
+use crate::summary::finish;
 use crate::write::{provenance, write_outputs, Written};
 use photonmap::display::Tev;
 use photonmap::error::Error;
 use photonmap::interrupt;
 use photonmap::memory::available_memory;
-use photonmap::metrics::{compare, reduction_factor, Window};
+use photonmap::metrics::{reduction_factor, Window};
 use photonmap::output::partial::{read_partial, Manifest, Part, Partial};
 use photonmap::output::read_exr;
-use photonmap::progress::{Mode, PassDisplay};
+use photonmap::progress::{Mode, PassDisplay, Wait};
 use photonmap::provenance::{method_name, settings_key, SceneId};
 use photonmap::render::accumulation::{parse_range, Accumulation};
 use photonmap::render::{render, render_passes, Budget, Stopped};
 use photonmap::scene::{Eye, Scene};
 use photonmap::settings::{Method, Settings, DEFAULT, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP};
-use photonmap::stats::Summary;
+use photonmap::stats::counted;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// The estimator (`--integrator`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -70,7 +73,7 @@ pub struct RenderArgs {
     /// Progressive rendering: passes 0 to N-1, averaged (with --resume:
     /// until the image holds N passes). Photon mapping narrows its
     /// estimates from pass to pass so the image converges to the true one.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000_000))]
+    #[arg(long, value_parser = count(1, 10_000_000))]
     passes: Option<u32>,
     /// Progressive rendering for this many seconds (no pass starts that
     /// would end later; at least one runs). Outputs are rewritten every 10
@@ -80,7 +83,8 @@ pub struct RenderArgs {
     time: Option<f64>,
     /// Progressive rendering until the predicted relative RMSE (of every
     /// --window, or of the whole image) is below this (0.02: 2%); checked
-    /// from the fourth pass on. --time caps it.
+    /// from the fourth pass on. --time caps it, else a week (a prediction
+    /// beyond the cap is said).
     #[arg(long, value_name = "E", value_parser = parse_target)]
     target_error: Option<f64>,
     /// A rectangle of pixels whose predicted error is reported (and, with
@@ -99,9 +103,10 @@ pub struct RenderArgs {
     #[arg(long, value_name = "PART.exr")]
     partial: Option<PathBuf>,
     /// Go on with the progressive render in this partial (same scene and
-    /// settings), from the pass after its last; --passes counts the passes
-    /// in the image, --time this run's seconds. --partial may name the same
-    /// file: it is replaced, atomically, by the longer render.
+    /// settings), from the pass after its last, until --passes (counting the
+    /// passes in the image), --time (this run's seconds) or --target-error:
+    /// one is needed. --partial may name the same file: it is replaced,
+    /// atomically, by the longer render.
     #[arg(long, value_name = "PART.exr", conflicts_with = "pass_range")]
     resume: Option<PathBuf>,
     /// Write a heat map of the per-pixel predicted error (progressive).
@@ -127,7 +132,7 @@ pub struct RenderArgs {
     /// from pass to pass)
     /// [default: 4, or rays_per_pixel_edge squared from a scene file; 1 for
     /// progressive renders].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    #[arg(long, value_parser = count(1, 1_000_000))]
     spp: Option<u32>,
     /// Seed of every random stream: the same image on any number of threads.
     #[arg(long, default_value_t = DEFAULT.seed, value_parser = parse_seed)]
@@ -136,22 +141,22 @@ pub struct RenderArgs {
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2))]
     eye: Option<u8>,
     /// Worker threads [default: all cores].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    #[arg(long, value_parser = count(1, 4096))]
     threads: Option<u32>,
     /// Image width in pixels [default: 800, or the scene file's]. A size of
     /// another shape than the camera's widens a look-at camera's view; a
     /// four-corner camera's plane must have the image's shape.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    #[arg(long, value_parser = count(1, 65_536))]
     width: Option<u32>,
     /// Image height in pixels [default: 800, or the scene file's].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    #[arg(long, value_parser = count(1, 65_536))]
     height: Option<u32>,
     /// Nearest photons per global-map irradiance estimate (at least 2: the
     /// estimate counts those strictly inside the k-th photon's distance).
-    #[arg(long, default_value_t = DEFAULT.k_global as u32, value_parser = clap::value_parser!(u32).range(2..=100_000))]
+    #[arg(long, default_value_t = DEFAULT.k_global as u32, value_parser = count(2, 100_000))]
     k: u32,
     /// Nearest photons per caustic estimate (at least 2).
-    #[arg(long, default_value_t = DEFAULT.k_caustic as u32, value_parser = clap::value_parser!(u32).range(2..=100_000))]
+    #[arg(long, default_value_t = DEFAULT.k_caustic as u32, value_parser = count(2, 100_000))]
     k_caustic: u32,
     /// Largest search radius of a global-map estimate, in scene units
     /// [default: 5% of the scene's diagonal].
@@ -161,19 +166,19 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_radius)]
     caustic_radius: Option<f32>,
     /// Final-gather rays per diffuse camera hit (0: no indirect light).
-    #[arg(long, default_value_t = DEFAULT.gather_rays, value_parser = clap::value_parser!(u32).range(0..=65_536))]
+    #[arg(long, default_value_t = DEFAULT.gather_rays, value_parser = count(0, 65_536))]
     gather_rays: u32,
     /// Of the gather rays, how many are aimed at the mirrors, glass and bright
     /// spots a point sees, if any; one at least stays cosine (0: all do).
-    #[arg(long, default_value_t = DEFAULT.aimed_gather_rays, value_parser = clap::value_parser!(u32).range(0..=65_536))]
+    #[arg(long, default_value_t = DEFAULT.aimed_gather_rays, value_parser = count(0, 65_536))]
     aimed_gather_rays: u32,
     /// Shadow rays per light per diffuse camera hit.
-    #[arg(long, default_value_t = DEFAULT.shadow_rays, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    #[arg(long, default_value_t = DEFAULT.shadow_rays, value_parser = count(1, 65_536))]
     shadow_rays: u32,
     /// Irradiance is precomputed at every N-th stored global photon, and
     /// final-gather rays read the nearest precomputed value [default: k / 6,
     /// 16 at k = 100, following k down in progressive passes].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536))]
+    #[arg(long, value_parser = count(1, 65_536))]
     cache_stride: Option<u32>,
     /// A pixel's later camera samples reuse its last caustic estimate where
     /// they land on the same surface within this fraction of that
@@ -182,7 +187,7 @@ pub struct RenderArgs {
     caustic_reuse: f32,
     /// Samples of the light seen in pixels on the rim of a light's image
     /// (directly or in mirrors and glass; 0: no extra samples).
-    #[arg(long, default_value_t = DEFAULT.edge_spp, value_parser = clap::value_parser!(u32).range(0..=1_000_000))]
+    #[arg(long, default_value_t = DEFAULT.edge_spp, value_parser = count(0, 1_000_000))]
     edge_spp: u32,
     /// Do everything even where the scene cannot use it (photon maps, shadow
     /// rays towards lights facing away): for checking that the skips change
@@ -254,6 +259,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
     let reference = cli.reference.as_deref().map(read_exr).transpose()?;
     let resumed = cli.resume.as_deref().map(read_partial).transpose()?;
     if let Some(threads) = cli.threads {
+        threads_within_cores(threads, cli.quiet);
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads as usize)
             .build_global()
@@ -261,6 +267,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
     }
 
     let loading = Instant::now();
+    let wait = Wait::start(Mode::detect(cli.quiet), loading_line(cli.scene.as_deref()));
     let (mut scene, file_spp, scene_id) = match &cli.scene {
         None => {
             let eye = if cli.eye == Some(2) { Eye::Two } else { Eye::One };
@@ -308,6 +315,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
             (Scene::from_parts(file.parts), n * n, id)
         }
     };
+    wait.finish();
     let load_time = loading.elapsed();
     let mut inputs: Vec<(&str, &std::path::Path)> = scene_id
         .inputs
@@ -323,6 +331,12 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
             "{}: the scene has no light (an emissive shape or a [[lights]] entry), so its image is black",
             scene_id.name
         )));
+    }
+    if let Some(path) = &cli.reference {
+        reference_shows(path, &scene_id, cli.quiet)?;
+    }
+    if cli.integrator == IntegratorArg::Path {
+        path_tracer_sees(&scene, cli.quiet)?;
     }
 
     let (width, height) = match &resumed {
@@ -415,6 +429,8 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
     }
     let mode = Mode::detect(cli.quiet);
     let tonemap = cli.tonemap.tonemap();
+    // From here a signal asks the render to stop and keep what it has.
+    interrupt::keep_work();
 
     let Some(plan) = plan else {
         // A classic render: one pass, no error estimate.
@@ -428,13 +444,13 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
         let written = Written { film: &film, error: None, attributes };
         let t = Instant::now();
         let files = write_outputs(&outputs, &written, None, tonemap, cli.exposure)?;
-        finish(&cli, &settings, &stats, load_time, t.elapsed(), start, &files, &film, reference.as_ref(), &[])?;
+        finish(cli.quiet, &settings, &stats, load_time, t.elapsed(), start, &files, &film, reference.as_ref(), &[])?;
         if !cli.quiet {
             eprintln!(
                 "  error        none estimated (a single pass; a progressive render, e.g. --time 60, estimates it)"
             );
         }
-        return Ok(Outcome::Done);
+        return Ok(interrupted_while_writing());
     };
 
     let mut tev = match &cli.display {
@@ -445,7 +461,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
         None => None,
     };
     let mut last_write = Instant::now();
-    let mut write_error = None;
+    let mut target_watch = TargetWatch::new();
     let display = PassDisplay::new(mode, plan.budget.clone(), plan.first);
     let mut part = Part { passes: String::new(), photons: 0, seconds: 0.0 };
     let partial_of = |acc: &Accumulation, part: &Part| Partial {
@@ -454,6 +470,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
     };
     let run = render_passes(&scene, &settings, plan.start.clone(), plan.first, &plan.budget, |report| {
         display.update(report);
+        target_watch.check(&plan.budget, report, cli.quiet);
         if let Some(t) = &mut tev {
             if let Err(e) = t.update(report.film) {
                 eprintln!("photonmap: warning: --display: {e}; the render goes on without it");
@@ -469,20 +486,17 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
             let attributes = provenance(&scene_id, &settings, passes, photons, part.seconds);
             let written = Written { film: report.film, error: report.error, attributes };
             let partial = outputs.partial.as_ref().map(|_| partial_of(report.accumulation, &part));
+            // A checkpoint that cannot be written (a full disk, a directory
+            // gone) is said and tried again at the next one and at the end:
+            // the passes are still in memory, and stopping would lose them.
             if let Err(e) = write_outputs(&outputs, &written, partial.as_ref(), tonemap, cli.exposure) {
-                // Said at once: the render stops rather than run on unsaved.
-                eprintln!("photonmap: error: {e}");
-                write_error = Some(e);
-                return ControlFlow::Break(());
+                eprintln!("photonmap: warning: {e}; the render goes on and writes again in {REWRITE_SECONDS} s");
             }
             last_write = Instant::now();
         }
         ControlFlow::Continue(())
     });
     display.finish();
-    if let Some(e) = write_error {
-        return Err(e);
-    }
     let film = run.film();
     let rendered = run.stats.passes;
     part.passes = format!("{}..{}", plan.first, plan.first + rendered);
@@ -499,7 +513,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
         write_outputs(&outputs, &written, partial.as_ref(), tonemap, cli.exposure)?
     };
     finish(
-        &cli,
+        cli.quiet,
         &settings,
         &run.stats,
         load_time,
@@ -519,16 +533,21 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
             Stopped::Caller => "an output could not be written".to_string(),
         };
         eprintln!(
-            "  stopped      {why} ({} passes in the image, {rendered} by this run)",
-            run.accumulation.passes.count()
+            "  stopped      {why} ({} in the image, {rendered} by this run)",
+            counted(run.accumulation.passes.count() as u64, "pass", "passes")
         );
     }
-    Ok(if run.stopped == Stopped::Interrupted { Outcome::Interrupted } else { Outcome::Done })
+    Ok(if run.stopped == Stopped::Interrupted { Outcome::Interrupted } else { interrupted_while_writing() })
 }
 
 /// The progressive plan: where to start, when to stop.
 fn plan(cli: &RenderArgs, manifest: &Manifest, resumed: Option<Partial>, windows: Vec<Window>) -> Result<Plan, Error> {
     let mut budget = Budget { end: cli.passes, seconds: cli.time, target_error: cli.target_error, windows };
+    // A target too small to reach would run forever: a week is the
+    // longest run, as for --time (said when a prediction shows it).
+    if budget.target_error.is_some() && budget.seconds.is_none() {
+        budget.seconds = Some(WEEK);
+    }
     if let Some(text) = &cli.pass_range {
         let (first, end) = match text.strip_suffix("..") {
             Some(a) => (parse_range(a).map_err(|e| Error::Invalid(format!("--pass-range {e}")))?.start, None),
@@ -549,6 +568,10 @@ fn plan(cli: &RenderArgs, manifest: &Manifest, resumed: Option<Partial>, windows
         let start = Accumulation::new(manifest.width, manifest.height);
         return Ok(Plan { start, first, budget, parts: Vec::new() });
     }
+    if budget.end.is_none() && budget.seconds.is_none() && budget.target_error.is_none() {
+        let what = if cli.resume.is_some() { "--resume" } else { "a progressive render" };
+        return Err(Error::Invalid(format!("{what} needs --passes, --time or --target-error to end it")));
+    }
     if let Some(p) = resumed {
         let path = cli.resume.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
         if let Some(why) = p.manifest.mismatch(manifest) {
@@ -564,79 +587,28 @@ fn plan(cli: &RenderArgs, manifest: &Manifest, resumed: Option<Partial>, windows
         }
         return Ok(Plan { first, budget, parts: p.manifest.parts, start: p.accumulation });
     }
-    if budget.end.is_none() && budget.seconds.is_none() && budget.target_error.is_none() {
-        return Err(Error::Invalid("a progressive render needs --passes, --time or --target-error".into()));
-    }
     Ok(Plan { start: Accumulation::new(manifest.width, manifest.height), first: 0, budget, parts: Vec::new() })
 }
 
-/// The summary, the predicted error and the reference's scores.
-#[allow(clippy::too_many_arguments)]
-fn finish(
-    cli: &RenderArgs,
-    settings: &Settings,
-    stats: &photonmap::stats::Stats,
-    load_time: Duration,
-    write_time: Duration,
-    start: Instant,
-    files: &[PathBuf],
-    film: &photonmap::film::Film,
-    reference: Option<&photonmap::film::Film>,
-    predictions: &[(String, photonmap::render::error_estimate::Prediction)],
-) -> Result<(), Error> {
-    if !cli.quiet {
-        let summary = Summary {
-            stats,
-            settings,
-            threads: rayon::current_num_threads(),
-            load_time,
-            write_time,
-            total_time: start.elapsed(),
-            written: files,
-        };
-        for line in summary.lines() {
-            eprintln!("{line}");
+/// What a long load says: the scene file and its size.
+fn loading_line(scene: Option<&std::path::Path>) -> String {
+    match scene {
+        Some(path) => {
+            let size = std::fs::metadata(path).map_or(String::new(), |m| format!(" ({:.1} MB)", m.len() as f64 / 1e6));
+            format!("photonmap: loading {}{size}", path.display())
         }
-        for (i, (name, p)) in predictions.iter().enumerate() {
-            eprintln!(
-                "  {}  {name}: RMSE {:.5} ({:.2}% of mean; noise {:.5}, bias {:.5}), relMSE {:.6}",
-                if i == 0 { "error      " } else { "           " },
-                p.rmse,
-                100.0 * p.relative_rmse(),
-                p.noise_rmse,
-                p.bias_rmse,
-                p.relmse
-            );
-        }
+        None => "photonmap: building the built-in room".into(),
     }
-    if stats.camera.nonfinite > 0 {
-        let (pixel, estimator) = stats.camera.first_nonfinite().unwrap_or((0, "?"));
-        eprintln!(
-            "photonmap: warning: {} non-finite samples were dropped; first in the {estimator} estimate at pixel ({}, {})",
-            stats.camera.nonfinite,
-            pixel % settings.width as u64,
-            pixel / settings.width as u64
-        );
+}
+
+/// A signal that came while the outputs were written (they are complete:
+/// each is renamed into place whole) still ends the run as interrupted, so
+/// a script does not take it for one that ran its course.
+fn interrupted_while_writing() -> Outcome {
+    if interrupt::requested() {
+        eprintln!("photonmap: interrupted while writing; the outputs written are complete");
+        Outcome::Interrupted
+    } else {
+        Outcome::Done
     }
-    if let Some(reference) = reference {
-        let m = compare(film, reference).ok_or_else(|| {
-            Error::Invalid(format!(
-                "--reference: a {}x{} image cannot be compared with a {}x{} reference",
-                film.width, film.height, reference.width, reference.height
-            ))
-        })?;
-        println!(
-            "{{\"seconds\": {:.3}, \"rmse\": {:.6}, \"relmse\": {:.6}, \"caustic_rmse\": {:.6}, \"mean_x\": {:.6}, \"mean_r\": {:.6}, \"caustic_mean_x\": {:.6}, \"caustic_mean_r\": {:.6}, \"nan_count\": {}}}",
-            start.elapsed().as_secs_f64(),
-            m.rmse,
-            m.relmse,
-            m.caustic_rmse,
-            m.mean_x,
-            m.mean_r,
-            m.caustic_mean_x,
-            m.caustic_mean_r,
-            m.nan_count
-        );
-    }
-    Ok(())
 }

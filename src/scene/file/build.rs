@@ -195,7 +195,7 @@ impl Builder<'_> {
                  light itself (remove `ambient` or set it to [0, 0, 0])",
             ));
         }
-        self.check_power()?;
+        self.check_power(ambient)?;
         let parts = SceneParts {
             prims: self.prims,
             shading_normals: self.shading_normals,
@@ -216,8 +216,11 @@ impl Builder<'_> {
     }
 
     /// The lights' power, added in double precision, must stay below
-    /// [`MAX_POWER`]; the brightest light is named.
-    fn check_power(&self) -> Result<(), SceneError> {
+    /// [`MAX_POWER`]; the brightest light is named. Lights that all emit
+    /// nothing (a radiance of 0, a disk too small for single precision to
+    /// give an area) are refused at the first, as a scene without light is
+    /// refused: the image would be black, whatever the summary then blames.
+    fn check_power(&self, ambient: Color) -> Result<(), SceneError> {
         let (mut lo, mut hi) = (glam::DVec3::splat(f64::MAX), glam::DVec3::splat(f64::MIN));
         for p in &self.prims {
             let (a, b) = p.shape.bounds();
@@ -243,6 +246,19 @@ impl Builder<'_> {
             })
             .collect();
         let total: f64 = powers.iter().sum();
+        // The renderer carries power in single precision: below its
+        // smallest normal number a light is dark.
+        if !powers.is_empty() && total < f32::MIN_POSITIVE as f64 && ambient == Color::ZERO {
+            let place = self.origins.lights.first().cloned().unwrap_or_default();
+            let some = if powers.len() == 1 { "" } else { ", nor does any other light" };
+            return Err(self.origins.error(
+                &place,
+                format!(
+                    "emits no light (a colour of 0, or a surface too small for single precision to give it an \
+                     area){some}, so the image would be black"
+                ),
+            ));
+        }
         if total.is_finite() && total <= MAX_POWER {
             return Ok(());
         }

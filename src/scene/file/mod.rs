@@ -15,10 +15,12 @@ mod light;
 mod locate;
 mod material;
 mod mitsuba_bsdf;
+mod read;
 mod shape;
 
 use super::SceneParts;
 use locate::Source;
+pub use read::{read_scene_text, MAX_SCENE_BYTES};
 use std::path::{Path, PathBuf};
 
 /// A mistake in a scene file, located.
@@ -89,19 +91,13 @@ pub struct SceneFile {
 /// Reads and checks a scene file. Relative OBJ paths are relative to the
 /// scene file's folder.
 pub fn load(path: &Path) -> Result<SceneFile, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
-        path: path.to_path_buf(),
-        line: 0,
-        column: 0,
-        field: "(file)".into(),
-        message: format!("cannot read the scene file: {e}"),
-    })?;
-    parse(&text, path)
+    parse(&read_scene_text(path)?, path)
 }
 
 /// Parses scene text as if read from `path` (used for messages and to find
 /// OBJ files next to it).
 pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
-    let src = Source { path, text };
+    let line_starts = locate::line_starts(text);
+    let src = Source { path, text, line_starts: &line_starts };
     build::build(src, src.deserialize()?)
 }
