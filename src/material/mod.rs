@@ -605,6 +605,14 @@ mod tests {
         assert_eq!(inside[0].prob, 1.0);
     }
 
+    /// Materials are copied freely and indexed per hit: the largest
+    /// variant (a rough plastic, its coat's tables shared by reference)
+    /// keeps the enum at 64 bytes.
+    #[test]
+    fn a_material_stays_small() {
+        assert!(std::mem::size_of::<Material>() <= 64, "{} bytes", std::mem::size_of::<Material>());
+    }
+
     #[test]
     fn what_photon_mapping_asks_of_each_material() {
         let [lambert, mirror, glass, phong] = materials().try_into().unwrap();
