@@ -42,6 +42,7 @@ mod conductor;
 mod dielectric;
 mod glossy;
 pub mod microfacet;
+mod mitsuba;
 mod phong;
 mod plastic;
 
@@ -312,8 +313,7 @@ impl Material {
         match self {
             Material::Lambertian { rho } => *rho,
             Material::Phong(p) => p.diffuse_rho(),
-            Material::Plastic(p) => p.diffuse_albedo(wo),
-            Material::RoughPlastic(p) => p.diffuse_albedo(wo),
+            Material::Plastic(_) | Material::RoughPlastic(_) => self.mitsuba_diffuse_albedo(wo),
             _ => Color::ZERO,
         }
     }
@@ -362,15 +362,9 @@ impl Material {
         match self {
             Material::Lambertian { rho } => max_component(*rho).min(1.0),
             Material::Phong(p) => p.lobe_weights().iter().sum::<f32>().min(1.0),
-            Material::Plastic(p) => p.albedo_bound(wo),
-            Material::RoughPlastic(p) => p.albedo_bound(wo),
-            Material::Mirror { .. }
-            | Material::Glass { .. }
-            | Material::Conductor(_)
-            | Material::ThinDielectric(_)
-            | Material::RoughConductor(_)
-            | Material::RoughDielectric(_) => 1.0,
+            Material::Mirror { .. } | Material::Glass { .. } => 1.0,
             Material::Emitter => 0.0,
+            _ => self.mitsuba_photon_survival(wo),
         }
     }
 
@@ -400,19 +394,14 @@ impl Material {
     /// only across a boundary (radiance's 1 / eta^2).
     #[inline]
     pub fn eval(&self, wo: Vec3, wi: Vec3, entering: bool, mode: Transport) -> Color {
-        if let Material::RoughDielectric(d) = self {
-            return d.eval(wo, wi, entering, mode);
-        }
-        if !(wi.z > 0.0) {
-            return Color::ZERO;
-        }
         match self {
-            Material::Lambertian { rho } => *rho / PI,
-            Material::Phong(p) => p.diffuse_rho() / PI + p.glossy(wo, wi),
-            Material::RoughConductor(c) => c.eval(wo, wi),
-            Material::Plastic(p) => p.eval(wo, wi),
-            Material::RoughPlastic(p) => p.eval(wo, wi),
-            _ => Color::ZERO,
+            Material::Lambertian { rho } if wi.z > 0.0 => *rho / PI,
+            Material::Phong(p) if wi.z > 0.0 => p.diffuse_rho() / PI + p.glossy(wo, wi),
+            Material::Lambertian { .. } | Material::Phong(_) | Material::Mirror { .. } | Material::Glass { .. } => {
+                Color::ZERO
+            }
+            Material::Emitter => Color::ZERO,
+            _ => self.mitsuba_eval(wo, wi, entering, mode),
         }
     }
 
@@ -429,11 +418,8 @@ impl Material {
                 }
                 (d * cosine_hemisphere_pdf(wi) + g * p.glossy_pdf(wo, wi)) / total
             }
-            Material::RoughConductor(c) => c.pdf(wo, wi),
-            Material::RoughDielectric(d) => d.pdf(wo, wi, entering),
-            Material::Plastic(p) => p.pdf(wo, wi),
-            Material::RoughPlastic(p) => p.pdf(wo, wi),
-            _ => 0.0,
+            Material::Mirror { .. } | Material::Glass { .. } | Material::Emitter => 0.0,
+            _ => self.mitsuba_pdf(wo, wi, entering),
         }
     }
 
@@ -467,31 +453,8 @@ impl Material {
                     }
                 }
             }
-            Material::Conductor(c) => {
-                let scale = c.reflectance(wo.z);
-                if max_component(scale) > 0.0 {
-                    Branches::one(Branch { wi: reflect(wo), prob: 1.0, scale })
-                } else {
-                    Branches::default()
-                }
-            }
-            Material::ThinDielectric(t) => {
-                let r = t.reflectance(wo.z);
-                let reflected = Branch { wi: reflect(wo), prob: r, scale: t.specular_reflectance };
-                let through = Branch { wi: -wo, prob: 1.0 - r, scale: t.specular_transmittance };
-                if r >= 1.0 {
-                    Branches::one(Branch { prob: 1.0, ..reflected })
-                } else {
-                    Branches { items: [Some(reflected), Some(through)] }
-                }
-            }
-            Material::Plastic(p) => {
-                let scale = p.coat(wo);
-                if max_component(scale) > 0.0 {
-                    Branches::one(Branch { wi: reflect(wo), prob: 1.0, scale })
-                } else {
-                    Branches::default()
-                }
+            Material::Conductor(_) | Material::ThinDielectric(_) | Material::Plastic(_) => {
+                self.mitsuba_specular_branches(wo)
             }
             _ => Branches::default(),
         }
@@ -505,13 +468,12 @@ impl Material {
     /// surface that reflects nothing, or a glossy sample below the surface.
     pub fn sample(&self, wo: Vec3, entering: bool, mode: Transport, rng: &mut Rng) -> Option<Scatter> {
         let specular = |b: Branch| Scatter { wi: b.wi, weight: b.scale, lobe: Lobe::Specular };
-        let glossy = |(wi, weight): (Vec3, Color)| Scatter { wi, weight, lobe: Lobe::Glossy };
         match self {
             Material::Lambertian { rho } => {
                 // Cosine sampling: f cos / pdf = (rho / pi) cos / (cos / pi) = rho.
                 Some(Scatter { wi: cosine_hemisphere(next_2d(rng)), weight: *rho, lobe: Lobe::Diffuse })
             }
-            Material::Mirror { .. } | Material::Glass { .. } | Material::Conductor(_) | Material::ThinDielectric(_) => {
+            Material::Mirror { .. } | Material::Glass { .. } => {
                 self.specular_branches(wo, entering, mode).choose(rng).map(specular)
             }
             Material::Phong(p) => {
@@ -537,27 +499,8 @@ impl Material {
                     Some(Scatter { weight: b.scale * (total / w[2]), ..specular(b) })
                 }
             }
-            Material::RoughConductor(c) => c.sample(wo, next_2d(rng)).map(glossy),
-            Material::RoughDielectric(d) => {
-                let u1 = rng.random::<f32>();
-                d.sample(wo, entering, mode, u1, next_2d(rng)).map(glossy)
-            }
-            Material::Plastic(p) => {
-                let (coat, chance) = p.choose_coat(wo, rng.random::<f32>());
-                if coat {
-                    let b = self.specular_branches(wo, entering, mode).choose(rng)?;
-                    return Some(Scatter { weight: b.scale / chance, ..specular(b) });
-                }
-                let wi = cosine_hemisphere(next_2d(rng));
-                let pdf = p.pdf(wo, wi);
-                (pdf > 0.0).then(|| Scatter { wi, weight: p.eval(wo, wi) * (wi.z / pdf), lobe: Lobe::Diffuse })
-            }
-            Material::RoughPlastic(p) => {
-                let u1 = rng.random::<f32>();
-                let (wi, coat, weight) = p.sample(wo, u1, next_2d(rng))?;
-                Some(Scatter { wi, weight, lobe: if coat { Lobe::Glossy } else { Lobe::Diffuse } })
-            }
             Material::Emitter => None,
+            _ => self.mitsuba_sample(wo, entering, mode, rng),
         }
     }
 }
@@ -660,6 +603,14 @@ mod tests {
             glass.specular_branches(grazing, false, Transport::Radiance).iter().copied().collect();
         assert_eq!(inside.len(), 1);
         assert_eq!(inside[0].prob, 1.0);
+    }
+
+    /// Materials are copied freely and indexed per hit: the largest
+    /// variant (a rough plastic, its coat's tables shared by reference)
+    /// keeps the enum at 64 bytes.
+    #[test]
+    fn a_material_stays_small() {
+        assert!(std::mem::size_of::<Material>() <= 64, "{} bytes", std::mem::size_of::<Material>());
     }
 
     #[test]
