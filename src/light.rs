@@ -273,7 +273,7 @@ impl Spot {
 impl Light {
     /// Whether the light is an ideal point or direction: one sample is exact.
     pub fn is_delta(&self) -> bool {
-        !matches!(self, Light::Area(_))
+        !matches!(self, Light::Area(_) | Light::Constant { .. } | Light::Envmap { .. })
     }
 
     /// The area light, if this is one.

@@ -179,7 +179,7 @@ fn sigterm_in_a_progressive_render_keeps_the_passes() {
     signal(&child, "TERM");
     let status = child.wait().unwrap();
     let rest: Vec<String> = lines.try_iter().collect();
-    assert_eq!(status.code(), Some(130), "{rest:?}");
+    assert_eq!(status.code(), Some(130), "{status:?} {rest:?}");
     assert!(rest.iter().any(|l| l.contains("interrupted; the passes finished are written")), "{rest:?}");
     let header = photonmap::output::read_header(&exr).unwrap();
     assert!(header.get("passes").is_some_and(|p| p.starts_with("0..")), "{:?}", header.attributes);
