@@ -331,7 +331,7 @@ impl Body<'_> {
 
     fn count(&mut self, t: Scalar) -> Result<usize, String> {
         let v = self.value(t)?;
-        if !(v >= 0.0 && v <= 1e6) || v.fract() != 0.0 {
+        if !(0.0..=1e6).contains(&v) || v.fract() != 0.0 {
             return Err(self.at(format!("a list length must be a count up to 1e6, got {v}")));
         }
         Ok(v as usize)

@@ -196,7 +196,7 @@ fn microfacet(p: &Plugin, anisotropic: bool) -> Result<(Distribution, f32, f32),
         _ => return Err(p.refuse("give either alpha or both alpha_u and alpha_v")),
     };
     for (name, a) in [("alpha", au), ("alpha", av)] {
-        if !(a >= 0.0 && a <= 10.0) {
+        if !(0.0..=10.0).contains(&a) {
             return Err(p.fail(p.loc(), name, format!("must lie in [0, 10], got {a}")));
         }
     }

@@ -24,7 +24,7 @@ const XYZ_TO_SRGB: [[f64; 3]; 3] =
     [[3.240479, -1.537150, -0.498535], [-0.969256, 1.875991, 0.041556], [0.055648, -0.204043, 1.057311]];
 
 /// Makes the CIE y-bar integrate to 1 over the tables' range.
-const Y_NORMALIZATION: f64 = 1.0 / 106.7502593994140625;
+const Y_NORMALIZATION: f64 = 1.0 / 106.750_259_399_414_06;
 /// Makes D65 against y-bar integrate to a luminance of 1.
 const D65_NORMALIZATION: f64 = 1.0 / 98.99741751876255;
 
