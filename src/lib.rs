@@ -46,3 +46,4 @@ pub mod settings;
 pub mod shape;
 pub mod stats;
 pub mod suite;
+pub mod texture;

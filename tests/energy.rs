@@ -44,6 +44,7 @@ fn furnace_with(le: f32, rho: f32, sphere: Option<Material>) -> Scene {
         camera,
         one_sided: Vec::new(),
         paths: photonmap::scene::PathLimits::default(),
+        texturing: Default::default(),
     })
 }
 

@@ -563,6 +563,7 @@ mod tests {
             camera: Scene::tncg15_parts(Eye::One).camera,
             one_sided: Vec::new(),
             paths: crate::scene::PathLimits::default(),
+            texturing: Default::default(),
         }
     }
 

@@ -62,7 +62,7 @@ impl Integrator for PathIntegrator<'_> {
                 break;
             };
             throughput *= self.scene.transmittance(departure, hit.t);
-            let material = self.scene.material_seen(&hit, ray.dir);
+            let material = &self.scene.material_seen(&hit, ray.dir);
             if count_emission && wanted && !hidden {
                 // A light's own surface, or a glowing one; after a diffuse
                 // bounce the shadow rays counted it.

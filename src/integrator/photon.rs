@@ -189,7 +189,7 @@ impl<'a> PhotonIntegrator<'a> {
         };
         let through = self.scene.transmittance(departure, hit.t);
         let w = w * through;
-        let material = self.scene.material_seen(&hit, ray.dir);
+        let material = &self.scene.material_seen(&hit, ray.dir);
         let emitted = if seen { self.scene.emitted(hit.prim, ray.dir) } else { Color::ZERO };
         if material.is_emitter() {
             return through * emitted;
@@ -389,7 +389,7 @@ impl<'a> PhotonIntegrator<'a> {
                 break;
             };
             weight *= self.scene.transmittance(Some(dep), y.t);
-            let material = self.scene.material_seen(&y, ray.dir);
+            let material = &self.scene.material_seen(&y, ray.dir);
             if from == Lobe::Glossy && specular {
                 found += weight * self.scene.emitted(y.prim, ray.dir);
             }

@@ -41,7 +41,7 @@ impl Whitted<'_> {
             return Color::ZERO;
         };
         let through = self.scene.transmittance(departure, hit.t);
-        let material = self.scene.material_seen(&hit, ray.dir);
+        let material = &self.scene.material_seen(&hit, ray.dir);
         let (frame, entering) = hit.scattering_frame(ray.dir, material);
         let shaded = match material.course_phong() {
             Some(p) => self.phong(&hit, ray, &frame, &p, depth, rng),

@@ -45,6 +45,7 @@ pub mod microfacet;
 mod mitsuba;
 mod phong;
 mod plastic;
+mod textured;
 
 pub use conductor::{Conductor, RoughConductor};
 pub use dielectric::{RoughDielectric, ThinDielectric};
@@ -52,6 +53,7 @@ pub use glossy::{Glossy, CAUSTIC_ROUGHNESS};
 pub use microfacet::{Distribution, Microfacet};
 pub use phong::Phong;
 pub use plastic::{fresnel_diffuse_reflectance, Plastic, RoughPlastic};
+pub use textured::{Param, Textured};
 
 use crate::math::{max_component, Color};
 use crate::optics::{fresnel_dielectric, reflect, refract};

@@ -326,7 +326,7 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
         return (false, false);
     };
     *power *= scene.transmittance(*departure, hit.t);
-    let material = scene.material_seen(&hit, ray.dir);
+    let material = &scene.material_seen(&hit, ray.dir);
     let (frame, entering) = hit.scattering_frame(ray.dir, material);
     let first_specular = bounce_now == 0 && material.is_specular();
     let stop = (false, first_specular);

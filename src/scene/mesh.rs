@@ -7,7 +7,7 @@
 //! that a device or a FIFO named as a mesh is refused instead of read
 //! without bound.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::io::BufRead;
 use std::path::Path;
 
@@ -19,6 +19,9 @@ pub struct ObjMesh {
     /// of the triangle's winding: the file's normals and its winding need
     /// not agree, and shading follows the winding.
     pub normals: Option<Vec<[Vec3; 3]>>,
+    /// Per triangle, its corners' texture coordinates as the file gives
+    /// them (`vt`), where every face corner has one.
+    pub uvs: Option<Vec<[Vec2; 3]>>,
 }
 
 /// Coordinates beyond this are refused, as in scene files
@@ -41,9 +44,12 @@ pub fn load_obj(path: &Path) -> Result<ObjMesh, String> {
     let mut reader = std::io::BufReader::with_capacity(1 << 16, file);
     let mut positions: Vec<Vec3> = Vec::new();
     let mut vertex_normals: Vec<Vec3> = Vec::new();
-    // Face corners as (position, normal) indices, three per triangle.
+    let mut texcoords: Vec<Vec2> = Vec::new();
+    // Face corners as (position, normal) indices, three per triangle, and
+    // their texture coordinates' indices.
     let mut corners: Vec<(u32, Option<u32>)> = Vec::new();
-    let mut polygon: Vec<(u32, Option<u32>)> = Vec::new();
+    let mut corner_uvs: Vec<Option<u32>> = Vec::new();
+    let mut polygon: Vec<(u32, Option<u32>, Option<u32>)> = Vec::new();
     let mut line = String::new();
     let mut number = 0usize;
     loop {
@@ -58,16 +64,20 @@ pub fn load_obj(path: &Path) -> Result<ObjMesh, String> {
         match words.next() {
             Some("v") => positions.push(vector(&mut words, "vertex").map_err(at)?),
             Some("vn") => vertex_normals.push(vector(&mut words, "normal").map_err(at)?),
+            Some("vt") => texcoords.push(texcoord(&mut words).map_err(at)?),
             Some("f") => {
                 polygon.clear();
                 for word in words {
-                    polygon.push(corner(word, positions.len(), vertex_normals.len()).map_err(at)?);
+                    polygon.push(corner(word, positions.len(), texcoords.len(), vertex_normals.len()).map_err(at)?);
                 }
                 if polygon.len() < 3 {
                     return Err(at(format!("a face needs at least 3 vertices, got {}", polygon.len())));
                 }
                 for i in 1..polygon.len() - 1 {
-                    corners.extend([polygon[0], polygon[i], polygon[i + 1]]);
+                    for c in [polygon[0], polygon[i], polygon[i + 1]] {
+                        corners.push((c.0, c.2));
+                        corner_uvs.push(c.1);
+                    }
                 }
             }
             _ => {}
@@ -94,7 +104,10 @@ pub fn load_obj(path: &Path) -> Result<ObjMesh, String> {
             })
             .collect()
     });
-    Ok(ObjMesh { triangles, normals })
+    let uvs = corner_uvs.iter().all(Option::is_some).then(|| {
+        corner_uvs.chunks_exact(3).map(|c| [0, 1, 2].map(|k| texcoords[c[k].expect("all present") as usize])).collect()
+    });
+    Ok(ObjMesh { triangles, normals, uvs })
 }
 
 /// Three finite coordinates within [`LIMIT`] (a fourth, `w`, is allowed and
@@ -111,9 +124,34 @@ fn vector<'a>(words: &mut impl Iterator<Item = &'a str>, what: &str) -> Result<V
     Ok(Vec3::from_array(v))
 }
 
+/// Texture coordinates `u v` (a third, `w`, is allowed and ignored; a
+/// missing `v` is 0, as the format allows).
+fn texcoord<'a>(words: &mut impl Iterator<Item = &'a str>) -> Result<Vec2, String> {
+    let mut v = [0.0f32; 2];
+    for (i, slot) in v.iter_mut().enumerate() {
+        let Some(word) = words.next() else {
+            if i == 0 {
+                return Err("texture coordinates need at least u".into());
+            }
+            break;
+        };
+        *slot = word.parse().map_err(|_| format!("texture coordinate {} is not a number: '{word}'", i + 1))?;
+        if !slot.is_finite() {
+            return Err(format!("texture coordinate {} must be finite, got {word}", i + 1));
+        }
+    }
+    Ok(Vec2::from_array(v))
+}
+
 /// One face corner, `v`, `v/vt`, `v//vn` or `v/vt/vn`, 1-based or negative
-/// (counted back from the last one read), as 0-based indices.
-fn corner(word: &str, positions: usize, normals: usize) -> Result<(u32, Option<u32>), String> {
+/// (counted back from the last one read), as 0-based indices (position,
+/// texture coordinates, normal).
+fn corner(
+    word: &str,
+    positions: usize,
+    texcoords: usize,
+    normals: usize,
+) -> Result<(u32, Option<u32>, Option<u32>), String> {
     let mut parts = word.split('/');
     let index = |text: &str, count: usize, what: &str| -> Result<u32, String> {
         let i: i64 =
@@ -125,12 +163,15 @@ fn corner(word: &str, positions: usize, normals: usize) -> Result<(u32, Option<u
         Ok(resolved as u32)
     };
     let position = index(parts.next().unwrap_or(""), positions, "vertex")?;
-    let _texture = parts.next();
+    let texture = match parts.next() {
+        Some(t) if !t.is_empty() => Some(index(t, texcoords, "texture coordinate")?),
+        _ => None,
+    };
     let normal = match parts.next() {
         Some(n) if !n.is_empty() => Some(index(n, normals, "normal")?),
         _ => None,
     };
-    Ok((position, normal))
+    Ok((position, texture, normal))
 }
 
 #[cfg(test)]

@@ -44,6 +44,9 @@ pub struct Hit {
     /// else the geometric one. On the geometric normal's side, unit.
     pub shading_normal: Vec3,
     pub prim: u32,
+    /// A triangle's barycentric weights of its second and third corners
+    /// (zero on other shapes): where textures and attributes are read.
+    pub bary: Vec2,
 }
 
 impl Hit {
@@ -174,6 +177,38 @@ pub struct Scene {
     pub paths: PathLimits,
     background: Color,
     envmap: Option<std::sync::Arc<crate::envmap::EnvMap>>,
+    /// Textures and the materials that read them; `None` in a scene
+    /// without textures, which then pays nothing for them.
+    texturing: Option<Box<Texturing>>,
+}
+
+/// A scene's textures ([`crate::texture`]): the textures, the materials
+/// that read them, and where on each primitive they are read.
+#[derive(Clone, Debug, Default)]
+pub struct Texturing {
+    pub textures: Vec<crate::texture::Texture>,
+    /// Per material: its recipe where it is textured (as long as the
+    /// materials, or shorter: the rest are plain).
+    pub materials: Vec<Option<crate::material::Textured>>,
+    /// Per primitive: its texture coordinates (as long as the primitives,
+    /// or shorter: the rest use their barycentrics).
+    pub surfaces: Vec<crate::texture::SurfaceUv>,
+    /// The analytic shapes' world-to-object transforms that `surfaces` name.
+    pub frames: Vec<glam::Affine3A>,
+}
+
+impl Texturing {
+    /// Whether any material reads a texture.
+    pub fn is_used(&self) -> bool {
+        self.materials.iter().any(Option::is_some)
+    }
+
+    /// Where textures are read at `hit`.
+    #[inline]
+    pub fn point(&self, hit: &Hit) -> crate::texture::SurfacePoint {
+        let surface = self.surfaces.get(hit.prim as usize).copied().unwrap_or(crate::texture::SurfaceUv::Barycentric);
+        crate::texture::SurfacePoint { uv: surface.uv(hit.point, hit.bary, &self.frames), prim: hit.prim, bary: hit.bary }
+    }
 }
 
 /// Marks a primitive that is not a light's surface.
@@ -235,6 +270,8 @@ pub struct SceneParts {
     /// the dielectrics). Empty: every material is two-sided.
     pub one_sided: Vec<bool>,
     pub paths: PathLimits,
+    /// Textures (empty: none).
+    pub texturing: Texturing,
 }
 
 /// What the scene says of the light paths to render (Mitsuba's
@@ -289,6 +326,10 @@ impl SceneParts {
                 }
             }
         }
+        let shrink = glam::Affine3A::from_scale(Vec3::splat(1.0 / s));
+        for f in &mut self.texturing.frames {
+            *f = *f * shrink;
+        }
         self.camera = self.camera.scaled(s);
         self
     }
@@ -323,8 +364,25 @@ impl Scene {
     /// `parts.prims`, in order), so that camera rays see them and photons are
     /// absorbed by them.
     pub fn from_parts(parts: SceneParts) -> Self {
-        let SceneParts { mut prims, shading_normals, mut materials, lights: specs, ambient, camera, one_sided, paths } =
-            parts;
+        let SceneParts {
+            mut prims,
+            shading_normals,
+            mut materials,
+            lights: specs,
+            ambient,
+            camera,
+            one_sided,
+            paths,
+            texturing,
+        } = parts;
+        // A textured material is its typical self wherever the scene asks
+        // about it as a whole.
+        for (m, t) in materials.iter_mut().zip(&texturing.materials) {
+            if let Some(t) = t {
+                *m = t.typical(&texturing.textures);
+            }
+        }
+        let texturing = texturing.is_used().then(|| Box::new(texturing));
         // A one-sided material's back is a black surface of its own.
         let back_material = if one_sided.iter().any(|&b| b) {
             let black = materials.len() as u32;
@@ -437,6 +495,7 @@ impl Scene {
             paths,
             background,
             envmap,
+            texturing,
         }
     }
 
@@ -459,6 +518,7 @@ impl Scene {
             normal: h.normal,
             shading_normal: self.shading_normal(&h),
             prim,
+            bary: Vec2::from_array(h.uv),
         })
     }
 
@@ -536,12 +596,17 @@ impl Scene {
     /// The material a ray travelling along `dir` meets at `hit`: a one-sided
     /// material's black back where it arrives behind the geometric normal.
     #[inline]
-    pub fn material_seen(&self, hit: &Hit, dir: Vec3) -> &Material {
-        let m = self.prim_material[hit.prim as usize];
-        if self.back_material.is_empty() || dir.dot(hit.normal) < 0.0 {
-            return &self.materials[m as usize];
+    pub fn material_seen(&self, hit: &Hit, dir: Vec3) -> Material {
+        let mut m = self.prim_material[hit.prim as usize];
+        if !(self.back_material.is_empty() || dir.dot(hit.normal) < 0.0) {
+            m = self.back_material[m as usize];
         }
-        &self.materials[self.back_material[m as usize] as usize]
+        if let Some(t) = &self.texturing {
+            if let Some(Some(recipe)) = t.materials.get(m as usize) {
+                return recipe.at(&t.point(hit), &t.textures);
+            }
+        }
+        self.materials[m as usize]
     }
 
     pub fn material(&self, prim: u32) -> &Material {

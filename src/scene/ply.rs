@@ -19,6 +19,80 @@ pub struct PlyMesh {
     /// Per vertex colour (0..1), from `red`/`green`/`blue` (or `r`, `g`, `b`).
     pub colors: Option<Vec<Vec3>>,
     pub triangles: Vec<[u32; 3]>,
+    /// The other properties of vertices and faces, grouped as Mitsuba 3
+    /// groups them (ply.cpp): `{prefix}_{x|y|z|w}`, `_{r|g|b|a}`,
+    /// `_{0|1|2|3}` or `_{1|2|3|4}` in a row make one attribute
+    /// `vertex_{prefix}` or `face_{prefix}`; `r g b (a)` or `red green blue
+    /// (alpha)` make `*_color`; any other property is one of its own.
+    pub attributes: Vec<Attribute>,
+}
+
+/// A vertex or face attribute: `dim` values per vertex, or per triangle
+/// (a face's values repeated for each triangle it is fanned into).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Attribute {
+    pub name: String,
+    pub per_face: bool,
+    pub dim: usize,
+    pub values: Vec<f32>,
+}
+
+impl Attribute {
+    /// The value at vertex or triangle `i` as a colour: one value is
+    /// grey, two or more fill the channels in order.
+    pub fn color(&self, i: usize) -> Vec3 {
+        let v = &self.values[i * self.dim..(i + 1) * self.dim];
+        match v.len() {
+            1 => Vec3::splat(v[0]),
+            2 => Vec3::new(v[0], v[1], 0.0),
+            _ => Vec3::new(v[0], v[1], v[2]),
+        }
+    }
+}
+
+/// Groups the properties at `candidates` (index, name) into attributes:
+/// (name without the element's prefix, property indices).
+fn group_attributes(candidates: &[(usize, String)]) -> Vec<(String, Vec<usize>)> {
+    const SCHEMES: [[&str; 4]; 4] = [["x", "y", "z", "w"], ["r", "g", "b", "a"], ["0", "1", "2", "3"], ["1", "2", "3", "4"]];
+    const COLOURS: [[&str; 4]; 2] = [["r", "g", "b", "a"], ["red", "green", "blue", "alpha"]];
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < candidates.len() {
+        let name = &candidates[i].1;
+        let run = |prefix: &str, scheme: &[&str; 4], joined: bool| -> usize {
+            let mut n = 0;
+            while n < 4 && i + n < candidates.len() {
+                let want = if joined { format!("{prefix}_{}", scheme[n]) } else { scheme[n].to_string() };
+                if candidates[i + n].1 != want {
+                    break;
+                }
+                n += 1;
+            }
+            n
+        };
+        let mut taken = None;
+        for c in COLOURS {
+            let n = run("", &c, false);
+            if n >= 3 {
+                taken = Some(("color".to_string(), n));
+            }
+        }
+        if taken.is_none() {
+            if let Some((prefix, _)) = name.rsplit_once('_') {
+                for sch in SCHEMES {
+                    let n = run(prefix, &sch, true);
+                    if n >= 1 && name.ends_with(&format!("_{}", sch[0])) {
+                        taken = Some((prefix.to_string(), n));
+                        break;
+                    }
+                }
+            }
+        }
+        let (group, n) = taken.unwrap_or((name.clone(), 1));
+        out.push((group, candidates[i..i + n].iter().map(|c| c.0).collect()));
+        i += n;
+    }
+    out
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -218,6 +292,21 @@ fn read_vertices(e: &Element, body: &mut Body, mesh: &mut PlyMesh) -> Result<(),
     let has_normals = normal.iter().all(Option::is_some);
     let has_uv = uv.iter().all(Option::is_some);
     let has_color = color.iter().all(Option::is_some);
+    let reserved = ["x", "y", "z", "nx", "ny", "nz", "u", "v", "s", "t", "texture_u", "texture_s", "texture_v", "texture_t"];
+    let candidates: Vec<(usize, String)> = e
+        .properties
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| match p {
+            Property::Scalar(n, _) if !reserved.contains(&n.as_str()) => Some((i, n.clone())),
+            _ => None,
+        })
+        .collect();
+    let groups = group_attributes(&candidates);
+    let first = mesh.attributes.len();
+    for (name, ix) in &groups {
+        mesh.attributes.push(Attribute { name: format!("vertex_{name}"), per_face: false, dim: ix.len(), values: Vec::new() });
+    }
     let mut values = vec![0f64; e.properties.len()];
     let (mut normals, mut uvs, mut colors) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..e.count {
@@ -240,6 +329,9 @@ fn read_vertices(e: &Element, body: &mut Body, mesh: &mut PlyMesh) -> Result<(),
             };
         }
         body.end_item()?;
+        for (a, (_, ix)) in mesh.attributes[first..].iter_mut().zip(&groups) {
+            a.values.extend(ix.iter().map(|&i| values[i] as f32));
+        }
         mesh.positions.push(Vec3::new(values[x] as f32, values[y] as f32, values[z] as f32));
         if has_normals {
             normals.push(Vec3::new(
@@ -272,12 +364,28 @@ fn read_faces(e: &Element, body: &mut Body, mesh: &mut PlyMesh) -> Result<(), St
         .iter()
         .position(|p| matches!(p, Property::List(n, _, _) if n == "vertex_indices" || n == "vertex_index"))
         .ok_or("the face element needs a vertex_indices list")?;
+    let candidates: Vec<(usize, String)> = e
+        .properties
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| match p {
+            Property::Scalar(n, _) => Some((i, n.clone())),
+            _ => None,
+        })
+        .collect();
+    let groups = group_attributes(&candidates);
+    let first = mesh.attributes.len();
+    for (name, ix) in &groups {
+        mesh.attributes.push(Attribute { name: format!("face_{name}"), per_face: true, dim: ix.len(), values: Vec::new() });
+    }
+    let mut values = vec![0f64; e.properties.len()];
     let mut polygon = Vec::new();
     for _ in 0..e.count {
+        let before = mesh.triangles.len();
         for (i, p) in e.properties.iter().enumerate() {
             match p {
                 Property::Scalar(_, t) => {
-                    body.value(*t)?;
+                    values[i] = body.value(*t)?;
                 }
                 Property::List(_, c, t) => {
                     let k = body.count(*c)?;
@@ -306,6 +414,11 @@ fn read_faces(e: &Element, body: &mut Body, mesh: &mut PlyMesh) -> Result<(), St
             }
         }
         body.end_item()?;
+        for _ in before..mesh.triangles.len() {
+            for (a, (_, ix)) in mesh.attributes[first..].iter_mut().zip(&groups) {
+                a.values.extend(ix.iter().map(|&i| values[i] as f32));
+            }
+        }
     }
     Ok(())
 }

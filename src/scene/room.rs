@@ -133,6 +133,7 @@ impl Scene {
             camera,
             one_sided: Vec::new(),
             paths: crate::scene::PathLimits::default(),
+            texturing: Default::default(),
         }
     }
 }

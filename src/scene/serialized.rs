@@ -268,7 +268,7 @@ fn shape(data: &[u8], version: u16) -> Result<SerializedMesh, String> {
     Ok(SerializedMesh {
         name,
         face_normals: flags & FACE_NORMALS != 0,
-        mesh: PlyMesh { positions, normals, uvs, colors, triangles: tris },
+        mesh: PlyMesh { positions, normals, uvs, colors, triangles: tris, attributes: Vec::new() },
     })
 }
 

@@ -205,6 +205,7 @@ impl Builder<'_> {
             camera,
             one_sided: Vec::new(),
             paths: crate::scene::PathLimits::default(),
+            texturing: Default::default(),
         };
         Ok(SceneFile {
             parts,

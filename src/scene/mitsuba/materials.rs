@@ -7,12 +7,13 @@
 use super::props::Plugin;
 use super::spectrum::{named_ior, Use};
 use super::Builder;
-use crate::material::{Distribution, Material};
+use crate::material::{Distribution, Material, Param, Textured};
 use crate::math::Color;
 use crate::scene::file::SceneError;
 
-/// A material and whether it is one-sided.
-type Built = (Material, bool);
+/// A material, its textured recipe where it reads textures, and whether
+/// it is one-sided.
+type Built = (Material, Option<Textured>, bool);
 
 impl Builder<'_> {
     /// The material index of a shape's BSDF (`None`: Mitsuba's default).
@@ -21,112 +22,207 @@ impl Builder<'_> {
         if let Some(&(_, m)) = self.material_cache.iter().find(|(k, _)| *k == key) {
             return Ok(m);
         }
-        let (material, one_sided) = match bsdf {
-            None => (Material::Lambertian { rho: Color::splat(0.5) }, true),
-            Some(p) => match bsdf_of(p) {
+        let grey = (Material::Lambertian { rho: Color::splat(0.5) }, None, true);
+        let (material, textured, one_sided) = match bsdf {
+            None => grey,
+            Some(p) => match self.bsdf_of(p) {
                 Ok(built) => built,
                 Err(e) => {
                     self.substitute(p, "a grey diffuse BSDF (reflectance 0.5) stands in", e)?;
-                    (Material::Lambertian { rho: Color::splat(0.5) }, true)
+                    grey
                 }
             },
         };
         let m = self.materials.len() as u32;
         self.materials.push(material);
+        self.textured.push(textured);
         self.one_sided.push(one_sided);
         self.material_cache.push((key, m));
         Ok(m)
     }
-}
 
-fn bsdf_of(p: &Plugin) -> Result<Built, SceneError> {
-    match p.kind {
-        "diffuse" => {
-            let rho = p.color("reflectance", Use::Reflectance)?.unwrap_or(Color::splat(0.5));
-            p.finish("reflectance")?;
-            Ok((Material::Lambertian { rho: bounded(p, "reflectance", rho)? }, true))
+    /// A reflectance: a colour within [0, 1] or a texture.
+    fn reflectance(&mut self, p: &Plugin, name: &str, default: f32) -> Result<Param, SceneError> {
+        let param = self.param(p, name, Use::Reflectance, Color::splat(default))?;
+        if let Param::Fixed(c) = param {
+            bounded(p, name, c)?;
         }
-        "dielectric" => {
-            let int = ior(p, "int_ior", "bk7")?;
-            let ext = ior(p, "ext_ior", "air")?;
-            for name in ["specular_reflectance", "specular_transmittance"] {
-                if let Some(c) = p.color(name, Use::Reflectance)? {
-                    if c != Color::ONE {
-                        return Err(p.fail(p.loc(), name, "only 1 (clear glass) is supported"));
+        Ok(param)
+    }
+
+    fn bsdf_of(&mut self, p: &Plugin) -> Result<Built, SceneError> {
+        let recipe = match p.kind {
+            "diffuse" => {
+                let reflectance = self.reflectance(p, "reflectance", 0.5)?;
+                p.finish("reflectance")?;
+                (Textured::Diffuse { reflectance }, true)
+            }
+            "blendbsdf" => {
+                let weight = self.param(p, "weight", Use::Unbounded, Color::splat(0.5))?;
+                if let Param::Fixed(w) = weight {
+                    if !(0.0..=1.0).contains(&w.x) {
+                        return Err(p.fail(p.loc(), "weight", format!("must lie in [0, 1], got {}", w.x)));
                     }
                 }
-            }
-            p.finish("int_ior, ext_ior")?;
-            Ok((Material::glass((int / ext) as f32), false))
-        }
-        "conductor" | "roughconductor" => {
-            let (eta, k) = complex_ior(p)?;
-            let specular = p.color("specular_reflectance", Use::Reflectance)?.unwrap_or(Color::ONE);
-            let specular = bounded(p, "specular_reflectance", specular)?;
-            if p.kind == "conductor" {
-                p.finish("material, eta, k, specular_reflectance")?;
-                return Ok((Material::conductor(eta, k, specular), true));
-            }
-            let (distribution, au, av) = microfacet(p, true)?;
-            p.finish("material, eta, k, specular_reflectance, distribution, alpha, alpha_u, alpha_v, sample_visible")?;
-            Ok((Material::rough_conductor(distribution, au, av, eta, k, specular), true))
-        }
-        "roughdielectric" | "thindielectric" => {
-            let (int, ext) = (ior(p, "int_ior", "bk7")?, ior(p, "ext_ior", "air")?);
-            if int == ext {
-                return Err(p.refuse("the interior and exterior indices of refraction must differ"));
-            }
-            let r = p.color("specular_reflectance", Use::Reflectance)?.unwrap_or(Color::ONE);
-            let t = p.color("specular_transmittance", Use::Reflectance)?.unwrap_or(Color::ONE);
-            let (r, t) = (bounded(p, "specular_reflectance", r)?, bounded(p, "specular_transmittance", t)?);
-            if p.kind == "thindielectric" {
-                p.finish("int_ior, ext_ior, specular_reflectance, specular_transmittance")?;
-                return Ok((Material::thin_dielectric(int as f32, ext as f32, r, t), false));
-            }
-            let (distribution, au, av) = microfacet(p, true)?;
-            p.finish(
-                "int_ior, ext_ior, specular_reflectance, specular_transmittance, distribution, alpha, alpha_u, \
-                 alpha_v, sample_visible",
-            )?;
-            Ok((Material::rough_dielectric(distribution, au, av, int as f32, ext as f32, r, t), false))
-        }
-        "plastic" | "roughplastic" => {
-            let (int, ext) = (ior(p, "int_ior", "polypropylene")?, ior(p, "ext_ior", "air")?);
-            if int == ext {
-                return Err(p.refuse("the interior and exterior indices of refraction must differ"));
-            }
-            let diffuse = p.color("diffuse_reflectance", Use::Reflectance)?.unwrap_or(Color::splat(0.5));
-            let diffuse = bounded(p, "diffuse_reflectance", diffuse)?;
-            let specular = p.color("specular_reflectance", Use::Reflectance)?.unwrap_or(Color::ONE);
-            let specular = bounded(p, "specular_reflectance", specular)?;
-            let nonlinear = p.boolean("nonlinear", false)?;
-            if p.kind == "plastic" {
-                p.finish("int_ior, ext_ior, diffuse_reflectance, specular_reflectance, nonlinear")?;
-                return Ok((Material::plastic(diffuse, specular, int as f32, ext as f32, nonlinear), true));
-            }
-            let (distribution, au, _) = microfacet(p, false)?;
-            p.finish(
-                "int_ior, ext_ior, diffuse_reflectance, specular_reflectance, nonlinear, distribution, alpha, \
-                 sample_visible",
-            )?;
-            Ok((Material::rough_plastic(distribution, au, diffuse, specular, int as f32, ext as f32, nonlinear), true))
-        }
-        "twosided" => {
-            let inner = p.objects("bsdf")?;
-            p.finish("one or two nested <bsdf>")?;
-            match &inner[..] {
-                [one] => {
-                    let (m, _) = bsdf_of(one)?;
-                    Ok((m, false))
+                let inner = p.objects("bsdf")?;
+                p.finish("weight, two nested <bsdf>")?;
+                let [a, b] = &inner[..] else {
+                    return Err(p.refuse(format!("a blendbsdf needs two nested <bsdf>, got {}", inner.len())));
+                };
+                let mut diffuse = |q: &Plugin| -> Result<(Param, bool), SceneError> {
+                    match self.bsdf_of(q)? {
+                        (_, Some(Textured::Diffuse { reflectance }), one) => Ok((reflectance, one)),
+                        (Material::Lambertian { rho }, None, one) => Ok((Param::Fixed(rho), one)),
+                        _ => Err(q.refuse(format!(
+                            "a blendbsdf is supported for two diffuse BSDFs (a '{}' is not yet)",
+                            q.kind
+                        ))),
+                    }
+                };
+                let ((first, one_a), (second, one_b)) = (diffuse(a)?, diffuse(b)?);
+                if one_a != one_b {
+                    return Err(b.refuse("a blendbsdf of a one-sided and a two-sided BSDF is not supported"));
                 }
-                [_, two] => Err(two.refuse("a twosided BSDF with a different back BSDF is not supported yet")),
-                _ => Err(p.refuse("a twosided BSDF needs one nested <bsdf>")),
+                (Textured::DiffuseBlend { weight, first, second }, one_a)
             }
-        }
-        k => Err(p.refuse(format!(
-            "the '{k}' BSDF is not supported yet (diffuse, dielectric, thindielectric, roughdielectric, conductor, \
-             roughconductor, plastic, roughplastic and twosided are)"
-        ))),
+            "dielectric" => {
+                let int = ior(p, "int_ior", "bk7")?;
+                let ext = ior(p, "ext_ior", "air")?;
+                for name in ["specular_reflectance", "specular_transmittance"] {
+                    if let Some(c) = p.color(name, Use::Reflectance)? {
+                        if c != Color::ONE {
+                            return Err(p.fail(p.loc(), name, "only 1 (clear glass) is supported"));
+                        }
+                    }
+                }
+                p.finish("int_ior, ext_ior")?;
+                return Ok((Material::glass((int / ext) as f32), None, false));
+            }
+            "conductor" | "roughconductor" => {
+                let (eta, k) = complex_ior(p)?;
+                let specular = self.reflectance(p, "specular_reflectance", 1.0)?;
+                if p.kind == "conductor" {
+                    p.finish("material, eta, k, specular_reflectance")?;
+                    (Textured::Conductor { eta, k, specular }, true)
+                } else {
+                    let (distribution, alpha_u, alpha_v) = self.microfacet(p, true)?;
+                    p.finish(
+                        "material, eta, k, specular_reflectance, distribution, alpha, alpha_u, alpha_v, sample_visible",
+                    )?;
+                    (Textured::RoughConductor { distribution, alpha_u, alpha_v, eta, k, specular }, true)
+                }
+            }
+            "roughdielectric" | "thindielectric" => {
+                let (int, ext) = (ior(p, "int_ior", "bk7")?, ior(p, "ext_ior", "air")?);
+                if int == ext {
+                    return Err(p.refuse("the interior and exterior indices of refraction must differ"));
+                }
+                let reflectance = self.reflectance(p, "specular_reflectance", 1.0)?;
+                let transmittance = self.reflectance(p, "specular_transmittance", 1.0)?;
+                if p.kind == "thindielectric" {
+                    let (Param::Fixed(r), Param::Fixed(t)) = (reflectance, transmittance) else {
+                        return Err(p.refuse("a thindielectric's reflectance and transmittance must be colours"));
+                    };
+                    p.finish("int_ior, ext_ior, specular_reflectance, specular_transmittance")?;
+                    return Ok((Material::thin_dielectric(int as f32, ext as f32, r, t), None, false));
+                }
+                let (distribution, alpha_u, alpha_v) = self.microfacet(p, true)?;
+                p.finish(
+                    "int_ior, ext_ior, specular_reflectance, specular_transmittance, distribution, alpha, alpha_u, \
+                     alpha_v, sample_visible",
+                )?;
+                let (int_ior, ext_ior) = (int as f32, ext as f32);
+                (
+                    Textured::RoughDielectric { distribution, alpha_u, alpha_v, int_ior, ext_ior, reflectance, transmittance },
+                    false,
+                )
+            }
+            "plastic" | "roughplastic" => {
+                let (int, ext) = (ior(p, "int_ior", "polypropylene")?, ior(p, "ext_ior", "air")?);
+                if int == ext {
+                    return Err(p.refuse("the interior and exterior indices of refraction must differ"));
+                }
+                let diffuse = self.reflectance(p, "diffuse_reflectance", 0.5)?;
+                let specular = self.reflectance(p, "specular_reflectance", 1.0)?;
+                let nonlinear = p.boolean("nonlinear", false)?;
+                let (int_ior, ext_ior) = (int as f32, ext as f32);
+                if p.kind == "plastic" {
+                    p.finish("int_ior, ext_ior, diffuse_reflectance, specular_reflectance, nonlinear")?;
+                    (Textured::Plastic { diffuse, specular, int_ior, ext_ior, nonlinear }, true)
+                } else {
+                    let (distribution, alpha, _) = self.microfacet(p, false)?;
+                    let Param::Fixed(alpha) = alpha else {
+                        return Err(p.refuse("a roughplastic's alpha must be a number (as in Mitsuba)"));
+                    };
+                    p.finish(
+                        "int_ior, ext_ior, diffuse_reflectance, specular_reflectance, nonlinear, distribution, alpha, \
+                         sample_visible",
+                    )?;
+                    let alpha = alpha.x;
+                    (Textured::RoughPlastic { distribution, alpha, diffuse, specular, int_ior, ext_ior, nonlinear }, true)
+                }
+            }
+            "twosided" => {
+                let inner = p.objects("bsdf")?;
+                p.finish("one or two nested <bsdf>")?;
+                return match &inner[..] {
+                    [one] => {
+                        let (m, t, _) = self.bsdf_of(one)?;
+                        Ok((m, t, false))
+                    }
+                    [_, two] => Err(two.refuse("a twosided BSDF with a different back BSDF is not supported yet")),
+                    _ => Err(p.refuse("a twosided BSDF needs one nested <bsdf>")),
+                };
+            }
+            k => {
+                return Err(p.refuse(format!(
+                    "the '{k}' BSDF is not supported yet (diffuse, dielectric, thindielectric, roughdielectric, \
+                     conductor, roughconductor, plastic, roughplastic, blendbsdf and twosided are)"
+                )))
+            }
+        };
+        let (textured, one_sided) = recipe;
+        // A stand-in with the same lobes until the scene holds the textures.
+        let material = textured.typical(&[]);
+        Ok((material, textured.reads_textures().then_some(textured), one_sided))
+    }
+
+    /// A microfacet distribution as Mitsuba reads it: `distribution`
+    /// (beckmann by default, or ggx), `alpha` (0.1 by default) or, where
+    /// `anisotropic`, `alpha_u` and `alpha_v` together, each a number or a
+    /// texture; `sample_visible` is read and its sampling always used (it
+    /// changes the noise, not the image).
+    fn microfacet(&mut self, p: &Plugin, anisotropic: bool) -> Result<(Distribution, Param, Param), SceneError> {
+        let distribution = match p.string("distribution")? {
+            None => Distribution::Beckmann,
+            Some((d, loc)) => match d.to_lowercase().as_str() {
+                "beckmann" => Distribution::Beckmann,
+                "ggx" => Distribution::Ggx,
+                _ => return Err(p.fail(&loc, "distribution", format!("'{d}' is not beckmann or ggx"))),
+            },
+        };
+        p.boolean("sample_visible", true)?;
+        let mut read = |name: &str| -> Result<Option<Param>, SceneError> {
+            if p.tag_of(name).is_none() {
+                return Ok(None);
+            }
+            let v = self.param(p, name, Use::Unbounded, Color::ZERO)?;
+            if let Param::Fixed(a) = v {
+                if !(0.0..=10.0).contains(&a.x) {
+                    return Err(p.fail(p.loc(), name, format!("must lie in [0, 10], got {}", a.x)));
+                }
+            }
+            Ok(Some(v))
+        };
+        let alpha = read("alpha")?;
+        let (au, av) = if anisotropic { (read("alpha_u")?, read("alpha_v")?) } else { (None, None) };
+        let (au, av) = match (alpha, au, av) {
+            (Some(a), None, None) => (a, a),
+            (None, Some(u), Some(v)) => (u, v),
+            (None, None, None) => (Param::Fixed(Color::splat(0.1)), Param::Fixed(Color::splat(0.1))),
+            _ => return Err(p.refuse("give either alpha or both alpha_u and alpha_v")),
+        };
+        Ok((distribution, au, av))
     }
 }
 
@@ -171,34 +267,4 @@ fn complex_ior(p: &Plugin) -> Result<(Color, Color), SceneError> {
         }),
         (_, eta, k) => Ok((eta.unwrap_or(Color::ZERO), k.unwrap_or(Color::ONE))),
     }
-}
-
-/// A microfacet distribution as Mitsuba reads it: `distribution`
-/// (beckmann by default, or ggx), `alpha` (0.1 by default) or, where
-/// `anisotropic`, `alpha_u` and `alpha_v` together; `sample_visible` is
-/// read and its sampling always used (it changes the noise, not the image).
-fn microfacet(p: &Plugin, anisotropic: bool) -> Result<(Distribution, f32, f32), SceneError> {
-    let distribution = match p.string("distribution")? {
-        None => Distribution::Beckmann,
-        Some((d, loc)) => match d.to_lowercase().as_str() {
-            "beckmann" => Distribution::Beckmann,
-            "ggx" => Distribution::Ggx,
-            _ => return Err(p.fail(&loc, "distribution", format!("'{d}' is not beckmann or ggx"))),
-        },
-    };
-    p.boolean("sample_visible", true)?;
-    let alpha = p.float("alpha")?;
-    let (au, av) = if anisotropic { (p.float("alpha_u")?, p.float("alpha_v")?) } else { (None, None) };
-    let (au, av) = match (alpha, au, av) {
-        (Some(a), None, None) => (a, a),
-        (None, Some(u), Some(v)) => (u, v),
-        (None, None, None) => (0.1, 0.1),
-        _ => return Err(p.refuse("give either alpha or both alpha_u and alpha_v")),
-    };
-    for (name, a) in [("alpha", au), ("alpha", av)] {
-        if !(0.0..=10.0).contains(&a) {
-            return Err(p.fail(p.loc(), name, format!("must lie in [0, 10], got {a}")));
-        }
-    }
-    Ok((distribution, au as f32, av as f32))
 }

@@ -25,6 +25,7 @@ pub mod props;
 mod sensor;
 mod shapes;
 pub mod spectrum;
+mod textures;
 pub mod xml;
 
 use super::file::{Origins, Place, SceneError, SceneFile};
@@ -92,6 +93,11 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
         max_depth: None,
         hide_emitters: false,
         depth_place: None,
+        textures: Vec::new(),
+        texture_cache: Vec::new(),
+        textured: Vec::new(),
+        surfaces: Vec::new(),
+        frames: Vec::new(),
     };
     let mut camera: Option<(Camera, u32, f64, Plugin)> = None;
     let mut integrator_seen = false;
@@ -156,6 +162,7 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
             format!("the scene reaches {farthest:.4e} from the eye, beyond far_clip {far}: photonmap does not clip far geometry"),
         ));
     }
+    let texturing = b.texturing();
     let parts = SceneParts {
         prims: b.prims,
         shading_normals: b.shading_normals,
@@ -165,6 +172,7 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
         camera,
         one_sided: b.one_sided,
         paths: super::PathLimits { max_depth: b.max_depth, hide_emitters: b.hide_emitters },
+        texturing,
     };
     let file = SceneFile {
         parts,
@@ -211,6 +219,13 @@ struct Builder<'a> {
     hide_emitters: bool,
     /// Where max_depth was given.
     depth_place: Option<Loc>,
+    textures: Vec<textures::Draft>,
+    texture_cache: Vec<(*const xml::Element, u32)>,
+    /// Per material, its recipe where it reads textures.
+    textured: Vec<Option<crate::material::Textured>>,
+    /// Per primitive, where textures are read on it.
+    surfaces: Vec<crate::texture::SurfaceUv>,
+    frames: Vec<glam::Affine3A>,
 }
 
 impl Builder<'_> {

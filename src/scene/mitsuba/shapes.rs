@@ -22,13 +22,23 @@ use crate::scene::ply::load_ply;
 use crate::scene::serialized::load_serialized;
 use crate::scene::{LightSpec, Prim};
 use crate::shape::{Cylinder, Disk, Ellipsoid, Shape, Sphere, Triangle};
-use glam::{Affine3A, DAffine3, DVec3, Vec3};
+use crate::texture::SurfaceUv;
+use glam::{Affine3A, DAffine3, DVec3, Vec2, Vec3};
 use std::collections::HashMap;
 
-/// Triangles in world space with their corners' normals, if smooth.
+/// Triangles in their own space with their corners' normals, if smooth,
+/// texture coordinates, if any, and attributes (name, corner values).
 struct Tris {
     tris: Vec<[Vec3; 3]>,
     normals: Option<Vec<[Vec3; 3]>>,
+    uvs: Option<Vec<[Vec2; 3]>>,
+    attributes: Vec<(String, Vec<[Color; 3]>)>,
+}
+
+impl Tris {
+    fn plain(tris: Vec<[Vec3; 3]>) -> Self {
+        Tris { tris, normals: None, uvs: None, attributes: Vec::new() }
+    }
 }
 
 impl Builder<'_> {
@@ -82,16 +92,17 @@ impl Builder<'_> {
             return Err(p.fail(p.loc(), "to_world", "the transform is singular"));
         }
         let object = self.new_object();
+        let mut uv = None;
         let mesh = match p.kind {
             "obj" | "ply" | "serialized" => {
                 let face_normals = p.boolean("face_normals", false)?;
                 let (name, loc) = p.string("filename")?.ok_or_else(|| p.refuse("needs a filename"))?;
                 let path = self.resolve(&name, &loc)?;
-                // Texture coordinates' orientation: read, no use yet.
-                p.boolean("flip_tex_coords", true)?;
-                let (tris, normals, shared) = if p.kind == "obj" {
+                // Mitsuba flips an OBJ's v by default, a PLY's only when asked.
+                let flip_v = p.boolean("flip_tex_coords", p.kind == "obj")?;
+                let (tris, normals, shared, uvs, attributes) = if p.kind == "obj" {
                     let m = load_obj(&path).map_err(|e| p.fail(&loc, "filename", e))?;
-                    (m.triangles, m.normals, None)
+                    (m.triangles, m.normals, None, m.uvs, Vec::new())
                 } else {
                     let m = if p.kind == "ply" {
                         load_ply(&path).map_err(|e| p.fail(&loc, "filename", e))?
@@ -105,20 +116,52 @@ impl Builder<'_> {
                     };
                     let tris: Vec<[Vec3; 3]> = m.triangles.iter().map(|t| t.map(|i| m.positions[i as usize])).collect();
                     let normals = m.normals.as_ref().map(|n| m.triangles.iter().map(|t| t.map(|i| n[i as usize])).collect());
-                    (tris, normals, Some(m.triangles.clone()))
+                    let uvs = m.uvs.as_ref().map(|uv| m.triangles.iter().map(|t| t.map(|i| uv[i as usize])).collect());
+                    let attributes = m
+                        .attributes
+                        .iter()
+                        .map(|a| {
+                            let per_tri = (0..m.triangles.len())
+                                .map(|f| {
+                                    if a.per_face {
+                                        [a.color(f); 3]
+                                    } else {
+                                        m.triangles[f].map(|i| a.color(i as usize))
+                                    }
+                                })
+                                .collect();
+                            (a.name.clone(), per_tri)
+                        })
+                        .collect();
+                    (tris, normals, Some(m.triangles.clone()), uvs, attributes)
                 };
+                let uvs = uvs.map(|uvs: Vec<[Vec2; 3]>| {
+                    if flip_v {
+                        uvs.into_iter().map(|t| t.map(|uv| Vec2::new(uv.x, 1.0 - uv.y))).collect()
+                    } else {
+                        uvs
+                    }
+                });
                 let normals = match (face_normals, normals) {
                     (true, _) => None,
                     (false, Some(n)) => Some(n),
                     (false, None) => Some(smooth_normals(&tris, shared.as_deref())),
                 };
-                Mesh::Tris(Tris { tris, normals })
+                Mesh::Tris(Tris { tris, normals, uvs, attributes })
             }
             "rectangle" => {
-                let c = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]].map(|[x, y]| Vec3::new(x, y, 0.0));
-                Mesh::Tris(Tris { tris: vec![[c[0], c[1], c[2]], [c[0], c[2], c[3]]], normals: None })
+                // Mitsuba's coordinates: (x + 1) / 2, (y + 1) / 2.
+                let uv = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]].map(Vec2::from_array);
+                let c = uv.map(|t| (2.0 * t - 1.0).extend(0.0));
+                Mesh::Tris(Tris {
+                    uvs: Some(vec![[uv[0], uv[1], uv[2]], [uv[0], uv[2], uv[3]]]),
+                    ..Tris::plain(vec![[c[0], c[1], c[2]], [c[0], c[2], c[3]]])
+                })
             }
-            "cube" => Mesh::Tris(Tris { tris: cube(), normals: None }),
+            "cube" => {
+                let (tris, uvs) = cube();
+                Mesh::Tris(Tris { uvs: Some(uvs), ..Tris::plain(tris) })
+            }
             "sphere" => {
                 let center = p.point("center")?.unwrap_or(DVec3::ZERO);
                 let radius = p.float_in("radius", 1.0, 0.0, 1e15)?;
@@ -126,6 +169,8 @@ impl Builder<'_> {
                     return Err(p.fail(p.loc(), "flip_normals", "a sphere with inward normals is not supported yet"));
                 }
                 let m = to_world * DAffine3::from_translation(center) * DAffine3::from_scale(DVec3::splat(radius));
+                self.frames.push(affine(&m.inverse()));
+                uv = Some(SurfaceUv::Sphere(self.frames.len() as u32 - 1));
                 Mesh::Analytic(match similarity(&m) {
                     Some(s) => Shape::Sphere(Sphere { center: m.translation.as_vec3(), radius: s as f32 }),
                     None => Shape::Ellipsoid(
@@ -152,6 +197,8 @@ impl Builder<'_> {
                     return Err(p.fail(p.loc(), "to_world", "a sheared cylinder is not supported"));
                 }
                 let (a, b) = (m.translation.as_vec3(), m.transform_point3(DVec3::Z).as_vec3());
+                self.frames.push(affine(&m.inverse()));
+                uv = Some(SurfaceUv::Cylinder(self.frames.len() as u32 - 1));
                 let c = Cylinder::new(a, b, x.length() as f32, flip)
                     .ok_or_else(|| p.fail(p.loc(), "to_world", "the cylinder is empty or not finite in world space"))?;
                 Mesh::Analytic(Shape::Cylinder(c))
@@ -164,6 +211,8 @@ impl Builder<'_> {
                     p.fail(p.loc(), "to_world", "a disk stretched into an ellipse is not supported (scale it uniformly)")
                 })?;
                 let normal = to_world.matrix3.z_axis.normalize().as_vec3();
+                self.frames.push(affine(&to_world.inverse()));
+                uv = Some(SurfaceUv::Disk(self.frames.len() as u32 - 1));
                 Mesh::Analytic(Shape::Disk(Disk { center: to_world.translation.as_vec3(), normal, radius: s as f32 }))
             }
             k => {
@@ -175,7 +224,10 @@ impl Builder<'_> {
         p.finish("filename, shape_index, face_normals, flip_normals, flip_tex_coords, to_world, center, radius, p0, p1, bsdf, emitter")?;
         match mesh {
             Mesh::Analytic(shape) => match (radiance, shape) {
-                (None, shape) => self.prims.push(Prim { shape, material, object }),
+                (None, shape) => {
+                    self.surface(self.prims.len(), uv.unwrap_or(SurfaceUv::Barycentric));
+                    self.prims.push(Prim { shape, material, object })
+                }
                 (Some(radiance), Shape::Disk(d)) => {
                     self.lights.push(LightSpec::Area { surface: Emitting::Disk(d), radiance, material: Some(material) })
                 }
@@ -216,6 +268,11 @@ impl Builder<'_> {
                     n.swap(1, 2);
                 }
             }
+            // Without coordinates of its own a triangle's are its barycentrics.
+            let mut uv = mesh.uvs.as_ref().map_or([Vec2::ZERO, Vec2::X, Vec2::Y], |uvs| uvs[i]);
+            if reverse {
+                uv.swap(1, 2);
+            }
             let mut t = Triangle::new(v[0], v[1], v[2]);
             if !(t.area() > 0.0) {
                 continue;
@@ -235,6 +292,18 @@ impl Builder<'_> {
                     t.shading = self.shading_normals.len() as u32;
                     self.shading_normals.push(n);
                 }
+            }
+            let prim = self.prims.len();
+            self.surface(prim, SurfaceUv::Triangle(uv));
+            if !mesh.attributes.is_empty() {
+                self.attributes(prim, |name| {
+                    let (_, values) = mesh.attributes.iter().find(|(n, _)| n == name)?;
+                    let mut c = values[i];
+                    if reverse {
+                        c.swap(1, 2);
+                    }
+                    Some(c)
+                });
             }
             self.prims.push(Prim { shape: Shape::Triangle(t), material, object });
         }
@@ -262,43 +331,46 @@ fn similarity(m: &DAffine3) -> Option<f64> {
 
 /// Mitsuba's cylinder frame (cylinder.cpp): the unit-radius, unit-length
 /// tube along z carried to the segment p0-p1 with the given radius; `None`
-/// for an empty segment or radius. The choice of the frame's x and y is
-/// free: the tube is round.
+/// for an empty segment or radius. Its x axis is where the texture's u
+/// starts, as Mitsuba's frame of the axis places it.
 fn cylinder_frame(p0: DVec3, p1: DVec3, radius: f64) -> Option<DAffine3> {
     let d = p1 - p0;
     let length = d.length();
     let axis = d.try_normalize().filter(|_| radius > 0.0 && length.is_finite())?;
-    let x = axis.any_orthonormal_vector();
-    let y = axis.cross(x);
+    let (x, y) = coordinate_system(axis);
     Some(DAffine3::from_cols(x * radius, y * radius, d, p0))
+}
+
+/// The tangents Mitsuba's `coordinate_system` gives a unit normal (Duff
+/// et al. 2017, "Building an orthonormal basis, revisited").
+fn coordinate_system(n: DVec3) -> (DVec3, DVec3) {
+    let sign = 1.0f64.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), DVec3::new(b, sign + n.y * n.y * a, -n.y))
 }
 
 fn affine(m: &DAffine3) -> Affine3A {
     Affine3A::from_mat3_translation(m.matrix3.as_mat3(), m.translation.as_vec3())
 }
 
-/// [-1, 1]^3 as 12 outward-wound triangles.
-fn cube() -> Vec<[Vec3; 3]> {
-    let mut out = Vec::new();
-    for axis in 0..3 {
-        for side in [-1.0f32, 1.0] {
-            let mut n = Vec3::ZERO;
-            n[axis] = side;
-            let (u, v) = {
-                let mut u = Vec3::ZERO;
-                let mut v = Vec3::ZERO;
-                u[(axis + 1) % 3] = 1.0;
-                v[(axis + 2) % 3] = 1.0;
-                (u, v)
-            };
-            let c = [n - u - v, n + u - v, n + u + v, n - u + v];
-            // Wound counter-clockwise seen from outside.
-            let (a, b) = if side > 0.0 { (1, 3) } else { (3, 1) };
-            out.push([c[0], c[a], c[2]]);
-            out.push([c[0], c[2], c[b]]);
+/// [-1, 1]^3 as 12 outward-wound triangles with Mitsuba's texture
+/// coordinates (cube.cpp): each face maps onto [0, 1]^2, its corners
+/// numbered as Mitsuba numbers them (corner c at (+-1, +-1, +-1), bit k
+/// of c the sign of axis k).
+fn cube() -> (Vec<[Vec3; 3]>, Vec<[Vec2; 3]>) {
+    const CORNERS: [u32; 24] = [1, 5, 4, 0, 3, 2, 6, 7, 1, 3, 7, 5, 5, 7, 6, 4, 4, 6, 2, 0, 3, 1, 0, 2];
+    let uv = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]].map(Vec2::from_array);
+    let corner = |c: u32| Vec3::new([-1.0, 1.0][(c & 1) as usize], [-1.0, 1.0][(c >> 1 & 1) as usize], [-1.0, 1.0][(c >> 2 & 1) as usize]);
+    let (mut tris, mut uvs) = (Vec::new(), Vec::new());
+    for side in 0..6 {
+        let v = |k: usize| corner(CORNERS[4 * side + k]);
+        for [a, b, c] in [[0, 1, 2], [3, 0, 2]] {
+            tris.push([v(a), v(b), v(c)]);
+            uvs.push([uv[a], uv[b], uv[c]]);
         }
     }
-    out
+    (tris, uvs)
 }
 
 /// Angle-weighted vertex normals, shared by the corners of one vertex:
@@ -336,7 +408,7 @@ mod tests {
 
     #[test]
     fn the_cube_faces_outwards_and_closes() {
-        let c = cube();
+        let (c, _) = cube();
         assert_eq!(c.len(), 12);
         let mut area = 0.0;
         for t in &c {
@@ -356,7 +428,7 @@ mod tests {
         for n in smooth_normals(&quad, None).iter().flatten() {
             assert!((*n - Vec3::Z).length() < 1e-6);
         }
-        let c = cube();
+        let (c, _) = cube();
         let n = smooth_normals(&c, None);
         let corner = Vec3::ONE.normalize();
         let found = c.iter().zip(&n).flat_map(|(t, n)| t.iter().zip(n)).find(|(p, _)| **p == Vec3::ONE).unwrap();

@@ -1,0 +1,170 @@
+//! Materials whose parameters vary over a surface: a recipe of fixed
+//! values and textures ([`crate::texture`]) that gives the plain
+//! [`Material`] at each point a ray or photon meets. Only materials of
+//! scenes that use textures are built this way; the rest are plain
+//! materials from the start.
+
+use super::{Distribution, Material};
+use crate::math::Color;
+use crate::texture::{SurfacePoint, Texture};
+
+/// A parameter: a fixed value or the value of texture number `n`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Param {
+    Fixed(Color),
+    Texture(u32),
+}
+
+impl Param {
+    #[inline]
+    fn color(self, at: &SurfacePoint, textures: &[Texture]) -> Color {
+        match self {
+            Param::Fixed(c) => c,
+            Param::Texture(i) => textures[i as usize].eval(at),
+        }
+    }
+
+    /// A number: a texture's `eval_1`.
+    #[inline]
+    fn number(self, at: &SurfacePoint, textures: &[Texture]) -> f32 {
+        match self {
+            Param::Fixed(c) => c.x,
+            Param::Texture(i) => textures[i as usize].eval_1(at),
+        }
+    }
+
+    /// The value averaged over the texture (one half for a texture not
+    /// in `textures`: a stand-in while a scene is read).
+    fn mean(self, textures: &[Texture]) -> Color {
+        match self {
+            Param::Fixed(c) => c,
+            Param::Texture(i) => textures.get(i as usize).map_or(Color::splat(0.5), Texture::mean),
+        }
+    }
+
+    pub fn is_texture(self) -> bool {
+        matches!(self, Param::Texture(_))
+    }
+}
+
+/// Mitsuba's BSDFs with their texturable parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Textured {
+    Diffuse { reflectance: Param },
+    /// Mitsuba's `blendbsdf` of two diffuse BSDFs: a diffuse BSDF of the
+    /// reflectances mixed by `weight` (0 is the first).
+    DiffuseBlend { weight: Param, first: Param, second: Param },
+    Conductor { eta: Color, k: Color, specular: Param },
+    RoughConductor { distribution: Distribution, alpha_u: Param, alpha_v: Param, eta: Color, k: Color, specular: Param },
+    RoughDielectric {
+        distribution: Distribution,
+        alpha_u: Param,
+        alpha_v: Param,
+        int_ior: f32,
+        ext_ior: f32,
+        reflectance: Param,
+        transmittance: Param,
+    },
+    Plastic { diffuse: Param, specular: Param, int_ior: f32, ext_ior: f32, nonlinear: bool },
+    RoughPlastic {
+        distribution: Distribution,
+        alpha: f32,
+        diffuse: Param,
+        specular: Param,
+        int_ior: f32,
+        ext_ior: f32,
+        nonlinear: bool,
+    },
+}
+
+impl Textured {
+    /// Whether any parameter is a texture (else the material is plain).
+    pub fn reads_textures(&self) -> bool {
+        let params: &[Param] = match self {
+            Textured::Diffuse { reflectance } => &[*reflectance],
+            Textured::DiffuseBlend { weight, first, second } => &[*weight, *first, *second],
+            Textured::Conductor { specular, .. } => &[*specular],
+            Textured::RoughConductor { alpha_u, alpha_v, specular, .. } => &[*alpha_u, *alpha_v, *specular],
+            Textured::RoughDielectric { alpha_u, alpha_v, reflectance, transmittance, .. } => {
+                &[*alpha_u, *alpha_v, *reflectance, *transmittance]
+            }
+            Textured::Plastic { diffuse, specular, .. } | Textured::RoughPlastic { diffuse, specular, .. } => {
+                &[*diffuse, *specular]
+            }
+        };
+        params.iter().any(|p| p.is_texture())
+    }
+
+    /// The material at `at`. Reflectances are kept within [0, 1] and
+    /// roughness within Mitsuba's range, whatever an image holds.
+    pub fn at(&self, at: &SurfacePoint, textures: &[Texture]) -> Material {
+        self.build(|p| p.color(at, textures), |p| p.number(at, textures))
+    }
+
+    /// The material with every texture at its mean: what the renderer
+    /// asks of a material as a whole (which lobes it has).
+    pub fn typical(&self, textures: &[Texture]) -> Material {
+        self.build(|p| p.mean(textures), |p| p.mean(textures).x)
+    }
+
+    fn build(&self, color: impl Fn(Param) -> Color, number: impl Fn(Param) -> f32) -> Material {
+        let unit = |p: Param| color(p).clamp(Color::ZERO, Color::ONE);
+        let alpha = |p: Param| number(p).clamp(0.0, 10.0);
+        match *self {
+            Textured::Diffuse { reflectance } => Material::Lambertian { rho: unit(reflectance) },
+            Textured::DiffuseBlend { weight, first, second } => {
+                let w = number(weight).clamp(0.0, 1.0);
+                Material::Lambertian { rho: unit(first) * (1.0 - w) + unit(second) * w }
+            }
+            Textured::Conductor { eta, k, specular } => Material::conductor(eta, k, unit(specular)),
+            Textured::RoughConductor { distribution, alpha_u, alpha_v, eta, k, specular } => {
+                Material::rough_conductor(distribution, alpha(alpha_u), alpha(alpha_v), eta, k, unit(specular))
+            }
+            Textured::RoughDielectric { distribution, alpha_u, alpha_v, int_ior, ext_ior, reflectance, transmittance } => {
+                Material::rough_dielectric(
+                    distribution,
+                    alpha(alpha_u),
+                    alpha(alpha_v),
+                    int_ior,
+                    ext_ior,
+                    unit(reflectance),
+                    unit(transmittance),
+                )
+            }
+            Textured::Plastic { diffuse, specular, int_ior, ext_ior, nonlinear } => {
+                Material::plastic(unit(diffuse), unit(specular), int_ior, ext_ior, nonlinear)
+            }
+            Textured::RoughPlastic { distribution, alpha, diffuse, specular, int_ior, ext_ior, nonlinear } => {
+                Material::rough_plastic(distribution, alpha, unit(diffuse), unit(specular), int_ior, ext_ior, nonlinear)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Affine2, Vec2};
+
+    #[test]
+    fn a_textured_diffuse_takes_the_texture_where_it_is_read() {
+        let textures = [Texture::Checkerboard {
+            color0: Color::splat(0.8),
+            color1: Color::new(0.1, 0.2, 0.3),
+            to_uv: Affine2::IDENTITY,
+        }];
+        let t = Textured::Diffuse { reflectance: Param::Texture(0) };
+        let at = |u: f32| SurfacePoint { uv: Vec2::new(u, 0.25), prim: 0, bary: Vec2::ZERO };
+        assert_eq!(t.at(&at(0.25), &textures), Material::Lambertian { rho: Color::splat(0.8) });
+        assert_eq!(t.at(&at(0.75), &textures), Material::Lambertian { rho: Color::new(0.1, 0.2, 0.3) });
+        let mean = t.typical(&textures).diffuse_rho().unwrap();
+        assert!((mean - Color::new(0.45, 0.5, 0.55)).length() < 1e-6);
+        let blend = Textured::DiffuseBlend {
+            weight: Param::Fixed(Color::splat(0.25)),
+            first: Param::Fixed(Color::ONE),
+            second: Param::Texture(0),
+        };
+        let rho = blend.at(&at(0.25), &textures).diffuse_rho().unwrap();
+        assert!((rho - Color::splat(0.75 + 0.25 * 0.8)).length() < 1e-6);
+    }
+}
