@@ -2,8 +2,9 @@
 //! from a latitude-longitude image, as Mitsuba 3's `envmap` defines it
 //! (src/emitters/envmap.cpp): in the map's own frame a direction d has
 //! u = atan2(d.x, -d.z) / 2π and v = acos(d.y) / π, +y up; the image is
-//! looked up bilinearly with texel centres at ((x + ½) / W, (y + ½) / H),
-//! periodic across u and clamped along v; `scale` multiplies it.
+//! looked up bilinearly with texel centres at u = (x + ½) / W, periodic,
+//! and, as Mitsuba aligns the rows with the poles, at v = y / (H - 1);
+//! `scale` multiplies it.
 //!
 //! Directions are drawn from the map's pixels in proportion to their
 //! luminance times sin θ (the solid angle a pixel spans), mixed with a
@@ -85,7 +86,7 @@ impl EnvMap {
 
     fn lookup(&self, uv: Vec2) -> Color {
         let x = uv.x * self.width as f32 - 0.5;
-        let y = uv.y * self.height as f32 - 0.5;
+        let y = uv.y * (self.height as f32 - 1.0);
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
