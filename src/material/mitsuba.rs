@@ -18,6 +18,7 @@ impl Material {
         match self {
             Material::Plastic(p) => p.albedo_bound(wo),
             Material::RoughPlastic(p) => p.albedo_bound(wo),
+            Material::Masked(m) => (max_component(m.rho()) + m.through()).min(1.0),
             _ => 1.0,
         }
     }
@@ -27,6 +28,7 @@ impl Material {
         match self {
             Material::Plastic(p) => p.diffuse_albedo(wo),
             Material::RoughPlastic(p) => p.diffuse_albedo(wo),
+            Material::Masked(m) => m.rho(),
             _ => Color::ZERO,
         }
     }
@@ -39,6 +41,7 @@ impl Material {
             Material::RoughConductor(c) => c.eval(wo, wi),
             Material::Plastic(p) => p.eval(wo, wi),
             Material::RoughPlastic(p) => p.eval(wo, wi),
+            Material::Masked(m) => m.rho() * std::f32::consts::FRAC_1_PI,
             _ => Color::ZERO,
         }
     }
@@ -50,6 +53,7 @@ impl Material {
             Material::RoughDielectric(d) => d.pdf(wo, wi, entering),
             Material::Plastic(p) => p.pdf(wo, wi),
             Material::RoughPlastic(p) => p.pdf(wo, wi),
+            Material::Masked(m) => m.opacity * crate::sampling::cosine_hemisphere_pdf(wi),
             _ => 0.0,
         }
     }
@@ -69,6 +73,9 @@ impl Material {
         match self {
             Material::Conductor(c) => mirror(c.reflectance(wo.z)),
             Material::Plastic(p) => mirror(p.coat(wo)),
+            Material::Masked(m) if m.through() > 0.0 => {
+                Branches::one(Branch { wi: -wo, prob: m.through(), scale: Color::ONE })
+            }
             Material::ThinDielectric(t) => {
                 let r = t.reflectance(wo.z);
                 let reflected = Branch { wi: reflect(wo), prob: r, scale: t.specular_reflectance };
@@ -105,6 +112,14 @@ impl Material {
                 let wi = cosine_hemisphere(next_2d(rng));
                 let pdf = p.pdf(wo, wi);
                 (pdf > 0.0).then(|| Scatter { wi, weight: p.eval(wo, wi) * (wi.z / pdf), lobe: Lobe::Diffuse })
+            }
+            Material::Masked(m) => {
+                if rng.random::<f32>() < m.opacity {
+                    // f cos / pdf = (opacity rho / pi) cos / (opacity cos / pi).
+                    Some(Scatter { wi: cosine_hemisphere(next_2d(rng)), weight: m.rho, lobe: Lobe::Diffuse })
+                } else {
+                    Some(Scatter { wi: -wo, weight: Color::ONE, lobe: Lobe::Specular })
+                }
             }
             Material::RoughPlastic(p) => {
                 let u1 = rng.random::<f32>();

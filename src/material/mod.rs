@@ -41,6 +41,7 @@
 mod conductor;
 mod dielectric;
 mod glossy;
+mod mask;
 pub mod microfacet;
 mod mitsuba;
 mod phong;
@@ -50,6 +51,7 @@ mod textured;
 pub use conductor::{Conductor, RoughConductor};
 pub use dielectric::{RoughDielectric, ThinDielectric};
 pub use glossy::{Glossy, CAUSTIC_ROUGHNESS};
+pub use mask::Masked;
 pub use microfacet::{Distribution, Microfacet};
 pub use phong::Phong;
 pub use plastic::{fresnel_diffuse_reflectance, Plastic, RoughPlastic};
@@ -106,6 +108,8 @@ pub enum Material {
     Plastic(Plastic),
     /// A diffuse base under a rough dielectric coat.
     RoughPlastic(RoughPlastic),
+    /// A diffuse surface cut out by an opacity ([`Masked`]).
+    Masked(Masked),
     /// A light's own surface: it emits (through its light) and reflects nothing.
     Emitter,
 }
@@ -261,6 +265,15 @@ impl Material {
         Material::RoughPlastic(RoughPlastic::new(microfacet, diffuse, specular, int_ior / ext_ior, nonlinear))
     }
 
+    /// What a one-sided material is seen as from behind: black, but for
+    /// a mask, which still lets light through.
+    pub fn back_side(&self) -> Material {
+        match *self {
+            Material::Masked(m) => Material::Masked(Masked { rho: Color::ZERO, ..m }),
+            _ => Material::Lambertian { rho: Color::ZERO },
+        }
+    }
+
     pub fn is_emitter(&self) -> bool {
         matches!(self, Material::Emitter)
     }
@@ -281,6 +294,7 @@ impl Material {
         match self {
             Material::Phong(p) => max_component(p.mirror_rho()) > 0.0,
             Material::Plastic(p) => max_component(p.specular) > 0.0,
+            Material::Masked(m) => m.through() > 0.0,
             Material::RoughConductor(_) | Material::RoughDielectric(_) | Material::RoughPlastic(_) => {
                 self.glossy().is_some_and(|g| g.carries_caustics())
             }
@@ -299,6 +313,7 @@ impl Material {
             Material::Phong(p) => p.diffuse_rho(),
             Material::Plastic(p) => p.diffuse,
             Material::RoughPlastic(p) => p.diffuse,
+            Material::Masked(m) => m.rho(),
             _ => return None,
         };
         (max_component(rho) > 0.0).then_some(rho)
@@ -316,6 +331,7 @@ impl Material {
             Material::Lambertian { rho } => *rho,
             Material::Phong(p) => p.diffuse_rho(),
             Material::Plastic(_) | Material::RoughPlastic(_) => self.mitsuba_diffuse_albedo(wo),
+            Material::Masked(m) => m.rho(),
             _ => Color::ZERO,
         }
     }
@@ -455,7 +471,7 @@ impl Material {
                     }
                 }
             }
-            Material::Conductor(_) | Material::ThinDielectric(_) | Material::Plastic(_) => {
+            Material::Conductor(_) | Material::ThinDielectric(_) | Material::Plastic(_) | Material::Masked(_) => {
                 self.mitsuba_specular_branches(wo)
             }
             _ => Branches::default(),

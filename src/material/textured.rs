@@ -51,6 +51,8 @@ impl Param {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Textured {
     Diffuse { reflectance: Param },
+    /// Mitsuba's `mask` over a diffuse BSDF.
+    Mask { opacity: Param, reflectance: Param },
     /// Mitsuba's `blendbsdf` of two diffuse BSDFs: a diffuse BSDF of the
     /// reflectances mixed by `weight` (0 is the first).
     DiffuseBlend { weight: Param, first: Param, second: Param },
@@ -82,6 +84,7 @@ impl Textured {
     pub fn reads_textures(&self) -> bool {
         let params: &[Param] = match self {
             Textured::Diffuse { reflectance } => &[*reflectance],
+            Textured::Mask { opacity, reflectance } => &[*opacity, *reflectance],
             Textured::DiffuseBlend { weight, first, second } => &[*weight, *first, *second],
             Textured::Conductor { specular, .. } => &[*specular],
             Textured::RoughConductor { alpha_u, alpha_v, specular, .. } => &[*alpha_u, *alpha_v, *specular],
@@ -112,6 +115,10 @@ impl Textured {
         let alpha = |p: Param| number(p).clamp(0.0, 10.0);
         match *self {
             Textured::Diffuse { reflectance } => Material::Lambertian { rho: unit(reflectance) },
+            Textured::Mask { opacity, reflectance } => Material::Masked(super::Masked {
+                opacity: number(opacity).clamp(0.0, 1.0),
+                rho: unit(reflectance),
+            }),
             Textured::DiffuseBlend { weight, first, second } => {
                 let w = number(weight).clamp(0.0, 1.0);
                 Material::Lambertian { rho: unit(first) * (1.0 - w) + unit(second) * w }

@@ -385,9 +385,24 @@ impl Scene {
         let texturing = texturing.is_used().then(|| Box::new(texturing));
         // A one-sided material's back is a black surface of its own.
         let back_material = if one_sided.iter().any(|&b| b) {
-            let black = materials.len() as u32;
-            materials.push(Material::Lambertian { rho: Color::ZERO });
-            (0..black).map(|m| if one_sided.get(m as usize) == Some(&true) { black } else { m }).collect()
+            let count = materials.len();
+            let mut backs = Vec::with_capacity(count);
+            for m in 0..count {
+                if one_sided.get(m) != Some(&true) {
+                    backs.push(m as u32);
+                    continue;
+                }
+                let back = materials[m].back_side();
+                let i = match materials[count..].iter().position(|b| *b == back) {
+                    Some(i) => count + i,
+                    None => {
+                        materials.push(back);
+                        materials.len() - 1
+                    }
+                };
+                backs.push(i as u32);
+            }
+            backs
         } else {
             Vec::new()
         };
@@ -597,16 +612,19 @@ impl Scene {
     /// material's black back where it arrives behind the geometric normal.
     #[inline]
     pub fn material_seen(&self, hit: &Hit, dir: Vec3) -> Material {
-        let mut m = self.prim_material[hit.prim as usize];
-        if !(self.back_material.is_empty() || dir.dot(hit.normal) < 0.0) {
-            m = self.back_material[m as usize];
-        }
+        let m = self.prim_material[hit.prim as usize] as usize;
+        let back = !(self.back_material.is_empty() || dir.dot(hit.normal) < 0.0) && self.back_material[m] as usize != m;
         if let Some(t) = &self.texturing {
-            if let Some(Some(recipe)) = t.materials.get(m as usize) {
-                return recipe.at(&t.point(hit), &t.textures);
+            if let Some(Some(recipe)) = t.materials.get(m) {
+                let material = recipe.at(&t.point(hit), &t.textures);
+                return if back { material.back_side() } else { material };
             }
         }
-        self.materials[m as usize]
+        if back {
+            self.materials[self.back_material[m] as usize]
+        } else {
+            self.materials[m]
+        }
     }
 
     pub fn material(&self, prim: u32) -> &Material {

@@ -85,6 +85,26 @@ impl Builder<'_> {
                 }
                 (Textured::DiffuseBlend { weight, first, second }, one_a)
             }
+            "mask" => {
+                let opacity = self.param(p, "opacity", Use::Unbounded, Color::splat(0.5))?;
+                if let Param::Fixed(o) = opacity {
+                    if !(0.0..=1.0).contains(&o.x) {
+                        return Err(p.fail(p.loc(), "opacity", format!("must lie in [0, 1], got {}", o.x)));
+                    }
+                }
+                let inner = p.objects("bsdf")?;
+                p.finish("opacity, one nested <bsdf>")?;
+                let [q] = &inner[..] else {
+                    return Err(p.refuse(format!("a mask needs one nested <bsdf>, got {}", inner.len())));
+                };
+                match self.bsdf_of(q)? {
+                    (_, Some(Textured::Diffuse { reflectance }), one) => (Textured::Mask { opacity, reflectance }, one),
+                    (Material::Lambertian { rho }, None, one) => {
+                        (Textured::Mask { opacity, reflectance: Param::Fixed(rho) }, one)
+                    }
+                    _ => return Err(q.refuse(format!("a mask is supported over a diffuse BSDF (a '{}' is not yet)", q.kind))),
+                }
+            }
             "dielectric" => {
                 let int = ior(p, "int_ior", "bk7")?;
                 let ext = ior(p, "ext_ior", "air")?;
@@ -177,7 +197,7 @@ impl Builder<'_> {
             k => {
                 return Err(p.refuse(format!(
                     "the '{k}' BSDF is not supported yet (diffuse, dielectric, thindielectric, roughdielectric, \
-                     conductor, roughconductor, plastic, roughplastic, blendbsdf and twosided are)"
+                     conductor, roughconductor, plastic, roughplastic, blendbsdf, mask and twosided are)"
                 )))
             }
         };
