@@ -47,6 +47,10 @@ pub struct Hit {
     /// A triangle's barycentric weights of its second and third corners
     /// (zero on other shapes): where textures and attributes are read.
     pub bary: Vec2,
+    /// The shading frame's first axis (unit, perpendicular to the shading
+    /// normal) where the surface's texture coordinates give one; zero
+    /// elsewhere, and the frame is the normal's own.
+    pub tangent: Vec3,
 }
 
 impl Hit {
@@ -73,10 +77,10 @@ impl Hit {
         let entering = dir.dot(self.normal) < 0.0;
         let geometric = self.facing_normal(dir);
         if self.shading_normal == self.normal {
-            return (Frame::from_normal(geometric), entering);
+            return (self.frame_about(geometric), entering);
         }
         let n = if entering { self.shading_normal } else { -self.shading_normal };
-        let frame = Frame::from_normal(n);
+        let frame = self.frame_about(n);
         let wo = frame.to_local(-dir);
         let sides_kept = wo.z > 0.0
             && material
@@ -86,8 +90,18 @@ impl Hit {
         if sides_kept {
             (frame, entering)
         } else {
-            (Frame::from_normal(geometric), entering)
+            (self.frame_about(geometric), entering)
         }
+    }
+
+    /// The frame about unit normal `n`: along the hit's tangent where it has one.
+    #[inline]
+    fn frame_about(&self, n: Vec3) -> Frame {
+        if self.tangent == Vec3::ZERO {
+            return Frame::from_normal(n);
+        }
+        let s = crate::texture::tangent_of(n, self.tangent);
+        Frame { s, t: n.cross(s), n }
     }
 
     /// Whether unit `dir`, leaving the surface for a ray that arrived along
@@ -195,12 +209,31 @@ pub struct Texturing {
     pub surfaces: Vec<crate::texture::SurfaceUv>,
     /// The analytic shapes' world-to-object transforms that `surfaces` name.
     pub frames: Vec<glam::Affine3A>,
+    /// Per material: the normal or bump map it is seen through, if any.
+    pub perturb: Vec<Option<crate::texture::Perturb>>,
 }
 
 impl Texturing {
     /// Whether any material reads a texture.
     pub fn is_used(&self) -> bool {
-        self.materials.iter().any(Option::is_some)
+        self.materials.iter().any(Option::is_some) || self.perturb.iter().any(Option::is_some)
+    }
+
+    /// Gives `hit` its shading frame from the texture coordinates, bent by
+    /// the material's normal or bump map.
+    #[inline(never)]
+    fn shade(&self, hit: &mut Hit, shape: &Shape, material: u32) {
+        let Some(surface) = self.surfaces.get(hit.prim as usize) else { return };
+        let tangents = crate::texture::tangents(surface, shape, hit.point, &self.frames);
+        hit.tangent = crate::texture::tangent_of(hit.shading_normal, tangents.0);
+        if let Some(Some(p)) = self.perturb.get(material as usize) {
+            let at = self.point(hit);
+            if let Some((n, s)) = p.apply(&at, &self.textures, hit.shading_normal, hit.normal, tangents) {
+                if n.dot(hit.normal) > 0.0 {
+                    (hit.shading_normal, hit.tangent) = (n, s);
+                }
+            }
+        }
     }
 
     /// Where textures are read at `hit`.
@@ -526,14 +559,21 @@ impl Scene {
 
     #[inline]
     pub fn intersect(&self, ray: &Ray, departure: Option<Departure>) -> Option<Hit> {
-        self.accel.closest_hit(ray, departure, f32::INFINITY).map(|(prim, h)| Hit {
-            t: h.t,
-            point: h.point,
-            p_err: h.p_err,
-            normal: h.normal,
-            shading_normal: self.shading_normal(&h),
-            prim,
-            bary: Vec2::from_array(h.uv),
+        self.accel.closest_hit(ray, departure, f32::INFINITY).map(|(prim, h)| {
+            let mut hit = Hit {
+                t: h.t,
+                point: h.point,
+                p_err: h.p_err,
+                normal: h.normal,
+                shading_normal: self.shading_normal(&h),
+                prim,
+                bary: Vec2::from_array(h.uv),
+                tangent: Vec3::ZERO,
+            };
+            if let Some(t) = &self.texturing {
+                t.shade(&mut hit, self.accel.shape(prim), self.prim_material[prim as usize]);
+            }
+            hit
         })
     }
 

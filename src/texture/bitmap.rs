@@ -137,6 +137,27 @@ impl Bitmap {
         }
     }
 
+    /// The derivatives of the bilinear lookup's luminance by texel
+    /// coordinates x and y at `uv` (zero for nearest lookup).
+    pub fn gradient(&self, uv: Vec2) -> Vec2 {
+        if self.filter == Filter::Nearest || !uv.is_finite() {
+            return Vec2::ZERO;
+        }
+        let p = uv * self.resolution() - 0.5;
+        let i = p.floor();
+        let w1 = p - i;
+        let w0 = Vec2::ONE - w1;
+        let (x, y) = (i.x as i64, i.y as i64);
+        let f = |dx, dy| crate::texture::luminance_or_grey(self.texel(x + dx, y + dy), self.channels == 1);
+        let (f00, f10, f01, f11) = (f(0, 0), f(1, 0), f(0, 1), f(1, 1));
+        Vec2::new(w0.y * (f10 - f00) + w1.y * (f11 - f01), w0.x * (f01 - f00) + w1.x * (f11 - f10))
+    }
+
+    /// Width and height.
+    pub fn resolution(&self) -> Vec2 {
+        Vec2::new(self.width as f32, self.height as f32)
+    }
+
     /// Whether the image is grey (one channel).
     pub fn is_grey(&self) -> bool {
         self.channels == 1

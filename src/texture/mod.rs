@@ -8,9 +8,11 @@
 //! [`crate::material::Material`]s and no hit computes a coordinate.
 
 pub mod bitmap;
+mod shading;
 mod surface;
 
 pub use bitmap::{Bitmap, Filter, Wrap};
+pub use shading::{tangent_of, tangents, Perturb};
 pub use surface::SurfaceUv;
 
 use crate::math::Color;
@@ -29,6 +31,8 @@ pub struct SurfacePoint {
 
 #[derive(Clone, Debug)]
 pub enum Texture {
+    /// One value everywhere (Mitsuba's `rawconstant`).
+    Constant(Color),
     Bitmap { image: Arc<Bitmap>, to_uv: Affine2 },
     /// Squares of `color0` and `color1`, two by two per unit of uv.
     Checkerboard { color0: Color, color1: Color, to_uv: Affine2 },
@@ -42,6 +46,7 @@ impl Texture {
     /// The colour at `at`.
     pub fn eval(&self, at: &SurfacePoint) -> Color {
         match self {
+            Texture::Constant(c) => *c,
             Texture::Bitmap { image, to_uv } => image.eval(to_uv.transform_point2(at.uv)),
             Texture::Checkerboard { color0, color1, to_uv } => {
                 if checker(to_uv.transform_point2(at.uv)) {
@@ -74,10 +79,28 @@ impl Texture {
         }
     }
 
+    /// The gradient of [`Self::eval_1`] by the texture coordinates, as
+    /// Mitsuba's `eval_1_grad` gives it: a bilinear image's exact
+    /// derivative through its `to_uv` (zero for nearest lookup and the
+    /// other textures, piecewise constant).
+    pub fn eval_1_grad(&self, at: &SurfacePoint) -> Vec2 {
+        match self {
+            Texture::Bitmap { image, to_uv } => {
+                let g = image.gradient(to_uv.transform_point2(at.uv));
+                let m = to_uv.matrix2;
+                // Mitsuba multiplies by the transform's transpose, then by the resolution.
+                let df = Vec2::new(m.x_axis.x * g.x + m.x_axis.y * g.y, m.y_axis.x * g.x + m.y_axis.y * g.y);
+                df * image.resolution()
+            }
+            _ => Vec2::ZERO,
+        }
+    }
+
     /// The texture's mean over its domain (a checkerboard's two colours
     /// equally, an image's texels, an attribute's primitives).
     pub fn mean(&self) -> Color {
         match self {
+            Texture::Constant(c) => *c,
             Texture::Bitmap { image, .. } => image.mean(),
             Texture::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
             Texture::Attribute { values, scale } => {
@@ -90,6 +113,7 @@ impl Texture {
     /// The largest value any channel takes.
     pub fn max(&self) -> f32 {
         match self {
+            Texture::Constant(c) => c.max_element(),
             Texture::Bitmap { image, .. } => image.max(),
             Texture::Checkerboard { color0, color1, .. } => color0.max_element().max(color1.max_element()),
             Texture::Attribute { values, scale } => {
@@ -101,6 +125,7 @@ impl Texture {
     /// The smallest value any channel takes.
     pub fn min(&self) -> f32 {
         match self {
+            Texture::Constant(c) => c.min_element(),
             Texture::Bitmap { image, .. } => image.min(),
             Texture::Checkerboard { color0, color1, .. } => color0.min_element().min(color1.min_element()),
             Texture::Attribute { values, scale } => {
@@ -115,6 +140,16 @@ impl Texture {
 fn checker(uv: Vec2) -> bool {
     let f = uv - uv.floor();
     (f.x > 0.5) == (f.y > 0.5)
+}
+
+/// A grey texel's value, or an RGB one's luminance.
+#[inline]
+pub fn luminance_or_grey(c: Color, grey: bool) -> f32 {
+    if grey {
+        c.x
+    } else {
+        luminance(c)
+    }
 }
 
 /// Rec. 709 luminance of linear RGB.

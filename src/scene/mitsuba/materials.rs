@@ -8,12 +8,13 @@ use super::props::Plugin;
 use super::spectrum::{named_ior, Use};
 use super::Builder;
 use crate::material::{Distribution, Material, Param, Textured};
+use crate::texture::Perturb;
 use crate::math::Color;
 use crate::scene::file::SceneError;
 
-/// A material, its textured recipe where it reads textures, and whether
-/// it is one-sided.
-type Built = (Material, Option<Textured>, bool);
+/// A material, its textured recipe where it reads textures, whether it is
+/// one-sided, and how it bends the shading normal.
+type Built = (Material, Option<Textured>, bool, Option<Perturb>);
 
 impl Builder<'_> {
     /// The material index of a shape's BSDF (`None`: Mitsuba's default).
@@ -22,8 +23,8 @@ impl Builder<'_> {
         if let Some(&(_, m)) = self.material_cache.iter().find(|(k, _)| *k == key) {
             return Ok(m);
         }
-        let grey = (Material::Lambertian { rho: Color::splat(0.5) }, None, true);
-        let (material, textured, one_sided) = match bsdf {
+        let grey = (Material::Lambertian { rho: Color::splat(0.5) }, None, true, None);
+        let (material, textured, one_sided, perturb) = match bsdf {
             None => grey,
             Some(p) => match self.bsdf_of(p) {
                 Ok(built) => built,
@@ -36,6 +37,7 @@ impl Builder<'_> {
         let m = self.materials.len() as u32;
         self.materials.push(material);
         self.textured.push(textured);
+        self.perturb.push(perturb);
         self.one_sided.push(one_sided);
         self.material_cache.push((key, m));
         Ok(m)
@@ -71,8 +73,8 @@ impl Builder<'_> {
                 };
                 let mut diffuse = |q: &Plugin| -> Result<(Param, bool), SceneError> {
                     match self.bsdf_of(q)? {
-                        (_, Some(Textured::Diffuse { reflectance }), one) => Ok((reflectance, one)),
-                        (Material::Lambertian { rho }, None, one) => Ok((Param::Fixed(rho), one)),
+                        (_, Some(Textured::Diffuse { reflectance }), one, None) => Ok((reflectance, one)),
+                        (Material::Lambertian { rho }, None, one, None) => Ok((Param::Fixed(rho), one)),
                         _ => Err(q.refuse(format!(
                             "a blendbsdf is supported for two diffuse BSDFs (a '{}' is not yet)",
                             q.kind
@@ -84,6 +86,32 @@ impl Builder<'_> {
                     return Err(b.refuse("a blendbsdf of a one-sided and a two-sided BSDF is not supported"));
                 }
                 (Textured::DiffuseBlend { weight, first, second }, one_a)
+            }
+            "normalmap" | "bumpmap" => {
+                let perturb = if p.kind == "normalmap" {
+                    match p.value("normalmap", Use::Unbounded)? {
+                        Some(super::props::Value::Texture(t)) => Perturb::NormalMap(self.texture(&t)?),
+                        Some(_) => return Err(p.fail(p.loc(), "normalmap", "must be a texture")),
+                        None => return Err(p.refuse("a normalmap needs a 'normalmap' texture")),
+                    }
+                } else {
+                    let scale = p.float_in("scale", 1.0, -1e6, 1e6)? as f32;
+                    let textures = p.objects("texture")?;
+                    let [t] = &textures[..] else {
+                        return Err(p.refuse(format!("a bumpmap needs one nested <texture>, got {}", textures.len())));
+                    };
+                    Perturb::BumpMap { texture: self.texture(t)?, scale }
+                };
+                let inner = p.objects("bsdf")?;
+                p.finish("normalmap, scale, one nested <texture> (bumpmap), one nested <bsdf>")?;
+                let [q] = &inner[..] else {
+                    return Err(p.refuse(format!("a {} needs one nested <bsdf>, got {}", p.kind, inner.len())));
+                };
+                let (material, textured, one_sided, nested) = self.bsdf_of(q)?;
+                if nested.is_some() {
+                    return Err(q.refuse("a normal or bump map inside another is not supported"));
+                }
+                return Ok((material, textured, one_sided, Some(perturb)));
             }
             "mask" => {
                 let opacity = self.param(p, "opacity", Use::Unbounded, Color::splat(0.5))?;
@@ -98,8 +126,8 @@ impl Builder<'_> {
                     return Err(p.refuse(format!("a mask needs one nested <bsdf>, got {}", inner.len())));
                 };
                 match self.bsdf_of(q)? {
-                    (_, Some(Textured::Diffuse { reflectance }), one) => (Textured::Mask { opacity, reflectance }, one),
-                    (Material::Lambertian { rho }, None, one) => {
+                    (_, Some(Textured::Diffuse { reflectance }), one, None) => (Textured::Mask { opacity, reflectance }, one),
+                    (Material::Lambertian { rho }, None, one, None) => {
                         (Textured::Mask { opacity, reflectance: Param::Fixed(rho) }, one)
                     }
                     _ => return Err(q.refuse(format!("a mask is supported over a diffuse BSDF (a '{}' is not yet)", q.kind))),
@@ -116,7 +144,7 @@ impl Builder<'_> {
                     }
                 }
                 p.finish("int_ior, ext_ior")?;
-                return Ok((Material::glass((int / ext) as f32), None, false));
+                return Ok((Material::glass((int / ext) as f32), None, false, None));
             }
             "conductor" | "roughconductor" => {
                 let (eta, k) = complex_ior(p)?;
@@ -144,7 +172,7 @@ impl Builder<'_> {
                         return Err(p.refuse("a thindielectric's reflectance and transmittance must be colours"));
                     };
                     p.finish("int_ior, ext_ior, specular_reflectance, specular_transmittance")?;
-                    return Ok((Material::thin_dielectric(int as f32, ext as f32, r, t), None, false));
+                    return Ok((Material::thin_dielectric(int as f32, ext as f32, r, t), None, false, None));
                 }
                 let (distribution, alpha_u, alpha_v) = self.microfacet(p, true)?;
                 p.finish(
@@ -187,8 +215,8 @@ impl Builder<'_> {
                 p.finish("one or two nested <bsdf>")?;
                 return match &inner[..] {
                     [one] => {
-                        let (m, t, _) = self.bsdf_of(one)?;
-                        Ok((m, t, false))
+                        let (m, t, _, perturb) = self.bsdf_of(one)?;
+                        Ok((m, t, false, perturb))
                     }
                     [_, two] => Err(two.refuse("a twosided BSDF with a different back BSDF is not supported yet")),
                     _ => Err(p.refuse("a twosided BSDF needs one nested <bsdf>")),
@@ -197,14 +225,14 @@ impl Builder<'_> {
             k => {
                 return Err(p.refuse(format!(
                     "the '{k}' BSDF is not supported yet (diffuse, dielectric, thindielectric, roughdielectric, \
-                     conductor, roughconductor, plastic, roughplastic, blendbsdf, mask and twosided are)"
+                     conductor, roughconductor, plastic, roughplastic, blendbsdf, mask, normalmap, bumpmap and twosided are)"
                 )))
             }
         };
         let (textured, one_sided) = recipe;
         // A stand-in with the same lobes until the scene holds the textures.
         let material = textured.typical(&[]);
-        Ok((material, textured.reads_textures().then_some(textured), one_sided))
+        Ok((material, textured.reads_textures().then_some(textured), one_sided, None))
     }
 
     /// A microfacet distribution as Mitsuba reads it: `distribution`

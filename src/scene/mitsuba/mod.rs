@@ -98,6 +98,7 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
         textured: Vec::new(),
         surfaces: Vec::new(),
         frames: Vec::new(),
+        perturb: Vec::new(),
     };
     let mut camera: Option<(Camera, u32, f64, Plugin)> = None;
     let mut integrator_seen = false;
@@ -226,6 +227,8 @@ struct Builder<'a> {
     /// Per primitive, where textures are read on it.
     surfaces: Vec<crate::texture::SurfaceUv>,
     frames: Vec<glam::Affine3A>,
+    /// Per material, the normal or bump map it is seen through.
+    perturb: Vec<Option<crate::texture::Perturb>>,
 }
 
 impl Builder<'_> {

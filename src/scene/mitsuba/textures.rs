@@ -88,6 +88,19 @@ impl Builder<'_> {
                 t.finish("color0, color1, to_uv")?;
                 Draft::Ready(Texture::Checkerboard { color0, color1, to_uv })
             }
+            "rawconstant" => {
+                // A value used as it is: no colour conversion (rawconstant.cpp).
+                let value = match t.tag_of("value") {
+                    Some("vector" | "point") => t.point("value")?.unwrap_or(glam::DVec3::ONE).as_vec3(),
+                    _ => match t.value("value", Use::Unbounded)? {
+                        Some(Value::Color(c)) => c,
+                        Some(Value::Texture(inner)) => return Err(inner.refuse("a rawconstant's value must be numbers")),
+                        None => Color::ONE,
+                    },
+                };
+                t.finish("value")?;
+                Draft::Ready(Texture::Constant(value))
+            }
             "mesh_attribute" => {
                 let (name, loc) = t.string("name")?.ok_or_else(|| t.refuse("a mesh_attribute needs a name"))?;
                 if !(name.starts_with("vertex_") || name.starts_with("face_")) {
@@ -99,7 +112,7 @@ impl Builder<'_> {
             }
             k => {
                 return Err(t.refuse(format!(
-                    "the '{k}' texture is not supported (bitmap, checkerboard and mesh_attribute are)"
+                    "the '{k}' texture is not supported (bitmap, checkerboard, mesh_attribute and rawconstant are)"
                 )))
             }
         };
@@ -146,6 +159,7 @@ impl Builder<'_> {
             materials: std::mem::take(&mut self.textured),
             surfaces: std::mem::take(&mut self.surfaces),
             frames: std::mem::take(&mut self.frames),
+            perturb: std::mem::take(&mut self.perturb),
         }
     }
 }
