@@ -13,7 +13,9 @@ use crate::math::{Color, Frame, Ray, Vertex};
 use crate::sampling::{concentric_disk, cosine_hemisphere, uniform_cone, uniform_triangle};
 use crate::shape::{Departure, Disk, Triangle};
 use glam::{Vec2, Vec3};
+use crate::texture::{SurfacePoint, Texture};
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 /// The surface of an area light.
 #[derive(Clone, Copy, Debug)]
@@ -166,7 +168,7 @@ pub enum Light {
 /// intensity Mitsuba 3 gives it (src/emitters/projector.cpp): π E s / cos³θ,
 /// so that a plane at unit distance facing it receives the same light
 /// wherever the frustum reaches it.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Projector {
     pub position: Vertex,
     /// The frame's x, y and z (the axis) in world space, unit.
@@ -175,6 +177,9 @@ pub struct Projector {
     pub scaled: Color,
     pub tan_x: f32,
     pub tan_y: f32,
+    /// An image projected (its irradiance times `scaled`), and its mean
+    /// over the window; `None`: constant.
+    pub pattern: Option<(Arc<Texture>, Color)>,
 }
 
 impl Projector {
@@ -190,16 +195,60 @@ impl Projector {
     #[inline]
     pub fn intensity_towards(&self, dir: Vec3) -> Color {
         match self.local(dir) {
-            Some(l) => self.scaled / (l.z * l.z * l.z),
+            Some(l) => self.scaled * self.pattern_at(l) / (l.z * l.z * l.z),
             None => Color::ZERO,
         }
     }
+
+    /// The image's value towards local direction `l`: Mitsuba's projector
+    /// maps the window onto [0, 1]^2 with u growing towards -x and v
+    /// towards -y (its perspective_projection).
+    #[inline]
+    fn pattern_at(&self, l: Vec3) -> Color {
+        match &self.pattern {
+            None => Color::ONE,
+            Some((t, _)) => {
+                let uv = Vec2::new(0.5 - 0.5 * l.x / (l.z * self.tan_x), 0.5 - 0.5 * l.y / (l.z * self.tan_y));
+                t.eval(&SurfacePoint { uv, prim: 0, bary: Vec2::ZERO })
+            }
+        }
+    }
+
+    /// The pattern's mean over the window (1 without one).
+    pub fn mean(&self) -> Color {
+        self.pattern.as_ref().map_or(Color::ONE, |p| p.1)
+    }
+
+    /// A pattern's mean over [0, 1]^2, on a grid finer than any image
+    /// photonmap reads in one lookup per texel.
+    pub fn window_mean(t: &Texture) -> Color {
+        grid_mean(|uv| t.eval(&SurfacePoint { uv, prim: 0, bary: Vec2::ZERO }))
+    }
+}
+
+/// The mean of `f` over the unit square by the midpoint rule on 512^2 cells.
+fn grid_mean(f: impl Fn(Vec2) -> Color) -> Color {
+    let n = 512;
+    let mut sum = glam::DVec3::ZERO;
+    for j in 0..n {
+        for i in 0..n {
+            sum += f(Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32)).as_dvec3();
+        }
+    }
+    (sum / (n * n) as f64).as_vec3()
+}
+
+/// A spot's image towards local direction `l`: Mitsuba's spot maps the
+/// cone onto uv as 0.5 + 0.5 (x, y) / (z tan cutoff) (spot.cpp).
+fn spot_texel(t: &Texture, l: Vec3, cutoff: f32) -> Color {
+    let k = 0.5 / (l.z * cutoff.tan());
+    t.eval(&SurfacePoint { uv: Vec2::new(0.5 + l.x * k, 0.5 + l.y * k), prim: 0, bary: Vec2::ZERO })
 }
 
 /// A spot light: intensity I along its axis out to `beam` (the half-angle
 /// of full intensity), then falling linearly in angle to zero at `cutoff`,
 /// as Mitsuba 3's `spot` emitter defines it (src/emitters/spot.cpp).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Spot {
     pub position: Vertex,
     /// z is the spot's axis.
@@ -211,6 +260,9 @@ pub struct Spot {
     inv_transition: f32,
     /// ∫ falloff dω over the sphere: power is I times it.
     solid_angle: f32,
+    /// An image the spot projects (Mitsuba's `texture`), and ∫ falloff
+    /// times it dω: power is I times that.
+    pattern: Option<(Arc<Texture>, Color)>,
 }
 
 impl Spot {
@@ -228,6 +280,7 @@ impl Spot {
             cutoff,
             inv_transition: 1.0 / (cutoff - beam),
             solid_angle: 0.0,
+            pattern: None,
         };
         // 2π ∫ falloff(θ) sin θ dθ over [0, cutoff], by the midpoint rule
         // on a fine grid (the falloff is piecewise smooth).
@@ -241,6 +294,43 @@ impl Spot {
             .sum();
         s.solid_angle = (2.0 * std::f64::consts::PI * sum * h) as f32;
         s
+    }
+
+    /// The spot projecting `texture` through its cone, in `frame` (x and y
+    /// as the spot's to_world places them).
+    pub fn with_pattern(mut self, texture: Arc<Texture>) -> Self {
+        // ∫ falloff T dω over the cone: the midpoint rule in (θ, φ).
+        let (nt, np) = (512, 512);
+        let mut sum = glam::DVec3::ZERO;
+        for i in 0..nt {
+            let theta = (i as f64 + 0.5) / nt as f64 * self.cutoff as f64;
+            let w = theta.sin() * (self.cutoff as f64 / nt as f64) * (2.0 * std::f64::consts::PI / np as f64);
+            let falloff = self.falloff(theta.cos() as f32) as f64;
+            for j in 0..np {
+                let phi = (j as f64 + 0.5) / np as f64 * 2.0 * std::f64::consts::PI;
+                let l = Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32);
+                sum += spot_texel(&texture, l, self.cutoff).as_dvec3() * falloff * w;
+            }
+        }
+        self.pattern = Some((texture, sum.as_vec3()));
+        self
+    }
+
+    /// ∫ falloff (times the pattern) dω: the power per unit intensity.
+    pub fn solid_angle(&self) -> Color {
+        match &self.pattern {
+            None => Color::splat(self.solid_angle),
+            Some((_, s)) => *s,
+        }
+    }
+
+    /// The pattern's value towards local direction `l` (1 without one).
+    #[inline]
+    pub fn pattern_at(&self, l: Vec3) -> Color {
+        match &self.pattern {
+            None => Color::ONE,
+            Some((t, _)) => spot_texel(t, l, self.cutoff),
+        }
     }
 
     /// The share of the axis' intensity sent at angle acos(cos_theta).
@@ -258,7 +348,12 @@ impl Spot {
     /// Intensity towards unit world direction `dir`.
     #[inline]
     pub fn intensity_towards(&self, dir: Vec3) -> Color {
-        self.intensity * self.falloff(dir.dot(self.frame.n))
+        let i = self.intensity * self.falloff(dir.dot(self.frame.n));
+        match self.pattern {
+            None => i,
+            Some(_) if i.max_element() > 0.0 => i * self.pattern_at(self.frame.to_local(dir)),
+            Some(_) => Color::ZERO,
+        }
     }
 
     pub fn cos_cutoff(&self) -> f32 {
@@ -342,7 +437,7 @@ impl Light {
                 let dir = uniform_cone(u, -1.0).normalize();
                 Some(Incident { dir, target: None, intensity: radiance * (4.0 * PI), prim: None })
             }
-            Light::Projector(pr) => {
+            Light::Projector(ref pr) => {
                 let to = pr.position - p;
                 let dist2 = to.length_squared();
                 if !(dist2 > 0.0) {
@@ -357,7 +452,7 @@ impl Light {
                     prim: None,
                 })
             }
-            Light::Spot(spot) => {
+            Light::Spot(ref spot) => {
                 let to = spot.position - p;
                 let dist2 = to.length_squared();
                 if !(dist2 > 0.0) {
@@ -400,12 +495,12 @@ impl Light {
             Light::Area(a) => PI * a.area() * a.radiance,
             Light::Point { intensity, .. } => 4.0 * PI * intensity,
             Light::Directional { irradiance, reach, .. } => PI * reach.1 * reach.1 * irradiance,
-            Light::Spot(s) => s.solid_angle * s.intensity,
+            Light::Spot(ref s) => s.solid_angle() * s.intensity,
             // Through the disk πR², from every direction: L 4π πR².
             Light::Constant { radiance, radius, .. } => radiance * (4.0 * PI * PI * radius * radius),
             Light::Envmap { ref map, radius, .. } => map.total() * (PI * radius * radius),
             // dω = cos³θ dA on the plane z = 1: the frustum's area there.
-            Light::Projector(p) => p.scaled * (4.0 * p.tan_x * p.tan_y),
+            Light::Projector(ref p) => p.scaled * p.mean() * (4.0 * p.tan_x * p.tan_y),
         }
     }
 
@@ -462,20 +557,29 @@ impl Light {
                 let d = concentric_disk(u_pos) * radius;
                 (Ray::new(origin + frame.s * d.x + frame.t * d.y, dir), None, Color::ONE)
             }
-            Light::Projector(p) => {
+            Light::Projector(ref p) => {
                 // Uniform on the frustum's window at z = 1: in proportion to
                 // the intensity, as dω = cos³θ dA.
                 let (x, y) = ((2.0 * u_dir.x - 1.0) * p.tan_x, (2.0 * u_dir.y - 1.0) * p.tan_y);
                 let dir = (p.axes[0] * x + p.axes[1] * y + p.axes[2]).normalize();
-                (Ray::new(p.position, dir), None, Color::ONE)
+                let weight = match &p.pattern {
+                    None => Color::ONE,
+                    Some(_) => p.pattern_at(Vec3::new(x, y, 1.0)) / p.mean().max(Color::splat(1e-30)),
+                };
+                (Ray::new(p.position, dir), None, weight)
             }
-            Light::Spot(s) => {
+            Light::Spot(ref s) => {
                 let local = uniform_cone(u_dir, s.cos_cutoff);
                 let dir = s.frame.to_world(local).normalize();
                 // (I falloff / pdf) / (I ∫ falloff dω), pdf = 1 / cone's solid angle.
                 let cone = 2.0 * PI * (1.0 - s.cos_cutoff);
-                let weight = if s.solid_angle > 0.0 { s.falloff(local.z) * cone / s.solid_angle } else { 0.0 };
-                (Ray::new(s.position, dir), None, Color::splat(weight))
+                let solid = s.solid_angle();
+                let weight = if solid.max_element() > 0.0 {
+                    s.pattern_at(local) * s.falloff(local.z) * cone / solid.max(Color::splat(1e-30))
+                } else {
+                    Color::ZERO
+                };
+                (Ray::new(s.position, dir), None, weight)
             }
         }
     }

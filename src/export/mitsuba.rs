@@ -276,7 +276,7 @@ pub fn to_mitsuba(
                     rgb(radiance)
                 );
             }
-            LightSpec::Spot { position, axis, intensity, cutoff_deg, beam_deg } => {
+            LightSpec::Spot { position, axis, intensity, cutoff_deg, beam_deg, .. } => {
                 emitters += &flush(&mut out, &mut tri_run);
                 let eye = at(position);
                 let target = eye + axis;

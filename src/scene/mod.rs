@@ -284,6 +284,9 @@ pub enum LightSpec {
         intensity: Color,
         cutoff_deg: f32,
         beam_deg: f32,
+        /// An image projected through the cone, with the spot's own x and
+        /// y axes (unit) that orient it.
+        pattern: Option<(std::sync::Arc<crate::texture::Texture>, Vec3, Vec3)>,
     },
 }
 
@@ -483,16 +486,26 @@ impl Scene {
                 LightSpec::Envmap(ref map) => {
                     lights.push(Light::Envmap { map: map.clone(), center: Vec3::ZERO, radius: 0.0 });
                 }
-                LightSpec::Projector(p) => {
+                LightSpec::Projector(ref p) => {
                     lo = lo.min(p.position);
                     hi = hi.max(p.position);
-                    lights.push(Light::Projector(p));
+                    lights.push(Light::Projector(p.clone()));
                 }
-                LightSpec::Spot { position, axis, intensity, cutoff_deg, beam_deg } => {
+                LightSpec::Spot { position, axis, intensity, cutoff_deg, beam_deg, ref pattern } => {
                     lo = lo.min(position);
                     hi = hi.max(position);
-                    let frame = crate::math::Frame::from_normal(axis);
-                    lights.push(Light::Spot(crate::light::Spot::new(position, frame, intensity, cutoff_deg, beam_deg)));
+                    let spot = match pattern {
+                        None => {
+                            let frame = crate::math::Frame::from_normal(axis);
+                            crate::light::Spot::new(position, frame, intensity, cutoff_deg, beam_deg)
+                        }
+                        Some((texture, x, y)) => {
+                            let frame = crate::math::Frame { s: *x, t: *y, n: axis };
+                            crate::light::Spot::new(position, frame, intensity, cutoff_deg, beam_deg)
+                                .with_pattern(texture.clone())
+                        }
+                    };
+                    lights.push(Light::Spot(spot));
                 }
             }
         }

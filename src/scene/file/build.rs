@@ -242,7 +242,7 @@ impl Builder<'_> {
                 }
                 LightSpec::Directional { irradiance, .. } => pi * reach * reach * irradiance.as_dvec3().max_element(),
                 LightSpec::Envmap(ref m) => pi * reach * reach * m.total().as_dvec3().max_element(),
-                LightSpec::Projector(p) => p.scaled.as_dvec3().max_element() * 4.0 * (p.tan_x * p.tan_y) as f64,
+                LightSpec::Projector(ref p) => p.scaled.as_dvec3().max_element() * 4.0 * (p.tan_x * p.tan_y) as f64,
                 LightSpec::Constant { radiance } => 4.0 * pi * pi * reach * reach * radiance.as_dvec3().max_element(),
             })
             .collect();

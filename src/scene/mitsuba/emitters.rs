@@ -4,7 +4,7 @@
 //! along `direction` or `to_world`'s +z; a spot light at `to_world`'s
 //! origin shining along its +z.
 
-use super::props::Plugin;
+use super::props::{Plugin, Value};
 use super::spectrum::Use;
 use super::Builder;
 use crate::math::Color;
@@ -14,7 +14,7 @@ use glam::{DAffine3, DVec3};
 
 impl Builder<'_> {
     pub(super) fn emitter(&mut self, p: &Plugin) -> Result<(), SceneError> {
-        let spec = if p.kind == "envmap" { self.envmap(p) } else { light_of(p) };
+        let spec = if p.kind == "envmap" { self.envmap(p) } else { self.light_of(p) };
         match spec {
             Ok(spec) => {
                 self.lights.push(spec);
@@ -59,7 +59,17 @@ impl Builder<'_> {
     }
 }
 
-fn light_of(p: &Plugin) -> Result<LightSpec, SceneError> {
+impl Builder<'_> {
+    /// A texture for an emitter: its own copy (emitters hold theirs).
+    fn emitter_texture(&mut self, t: &Plugin) -> Result<std::sync::Arc<crate::texture::Texture>, SceneError> {
+        let i = self.texture(t)?;
+        match &self.textures[i as usize] {
+            super::textures::Draft::Ready(t) => Ok(std::sync::Arc::new(t.clone())),
+            super::textures::Draft::Attribute { .. } => Err(t.refuse("an emitter cannot read a mesh attribute")),
+        }
+    }
+
+fn light_of(&mut self, p: &Plugin) -> Result<LightSpec, SceneError> {
     let spec = match p.kind {
         "point" => {
             let position = match (p.point("position")?, p.transform("to_world")?) {
@@ -88,38 +98,69 @@ fn light_of(p: &Plugin) -> Result<LightSpec, SceneError> {
             let intensity = p.color("intensity", Use::Emission)?.unwrap_or(Color::ONE);
             let cutoff = p.float_in("cutoff_angle", 20.0, 1e-3, 180.0)?;
             let beam = p.float_in("beam_width", cutoff * 0.75, 0.0, 180.0)?;
-            p.finish("to_world, intensity, cutoff_angle, beam_width")?;
+            let texture = match p.value("texture", Use::Reflectance)? {
+                None => None,
+                Some(Value::Texture(t)) => Some(self.emitter_texture(&t)?),
+                Some(Value::Color(c)) => Some(std::sync::Arc::new(crate::texture::Texture::Constant(c))),
+            };
+            p.finish("to_world, intensity, cutoff_angle, beam_width, texture")?;
             let axis = m
                 .transform_vector3(DVec3::Z)
                 .try_normalize()
                 .ok_or_else(|| p.fail(p.loc(), "to_world", "is singular"))?;
+            let pattern = match texture {
+                None => None,
+                Some(t) => {
+                    let x = m.transform_vector3(DVec3::X);
+                    let x = (x - axis * x.dot(axis)).try_normalize().ok_or_else(|| p.fail(p.loc(), "to_world", "is singular"))?;
+                    Some((t, x.as_vec3(), axis.cross(x).as_vec3()))
+                }
+            };
             LightSpec::Spot {
                 position: m.translation.as_vec3(),
                 axis: axis.as_vec3(),
                 intensity,
                 cutoff_deg: cutoff as f32,
                 beam_deg: beam.min(cutoff) as f32,
+                pattern,
             }
         }
         "projector" => {
             let m = p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
-            let irradiance = p.color("irradiance", Use::Emission)?.unwrap_or(Color::ONE);
+            let (irradiance, pattern) = match p.value("irradiance", Use::Emission)? {
+                None => (Color::ONE, None),
+                Some(Value::Color(c)) => (c, None),
+                Some(Value::Texture(t)) => (Color::ONE, Some(self.emitter_texture(&t)?)),
+            };
             let scale = p.float_in("scale", 1.0, 0.0, 1e30)?;
-            // A constant irradiance is a 1 x 1 image: a square frustum.
-            let x_fov = super::sensor::fov(p, 1.0)?;
+            // The window has the image's aspect (a constant irradiance is
+            // a 1 x 1 image: a square frustum).
+            let aspect = match pattern.as_deref() {
+                Some(crate::texture::Texture::Bitmap { image, .. }) => {
+                    let r = image.resolution();
+                    (r.x / r.y) as f64
+                }
+                _ => 1.0,
+            };
+            let x_fov = super::sensor::fov(p, aspect)?;
             p.finish("to_world, irradiance, scale, fov, fov_axis")?;
             let axes = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis];
             let Some(axes) = axes.iter().map(|a| a.try_normalize().map(|a| a.as_vec3())).collect::<Option<Vec<_>>>()
             else {
                 return Err(p.fail(p.loc(), "to_world", "is singular"));
             };
-            let t = (0.5 * x_fov.to_radians()).tan() as f32;
+            let t = (0.5 * x_fov.to_radians()).tan();
+            let pattern = pattern.map(|t| {
+                let mean = crate::light::Projector::window_mean(&t);
+                (t, mean)
+            });
             LightSpec::Projector(crate::light::Projector {
                 position: m.translation.as_vec3(),
                 axes: [axes[0], axes[1], axes[2]],
                 scaled: irradiance * (std::f32::consts::PI * scale as f32),
-                tan_x: t,
-                tan_y: t,
+                tan_x: t as f32,
+                tan_y: (t / aspect) as f32,
+                pattern,
             })
         }
         "area" => return Err(p.refuse("an area emitter must be nested in the <shape> that emits")),
@@ -143,4 +184,5 @@ fn light_of(p: &Plugin) -> Result<LightSpec, SceneError> {
         }
     }
     Ok(spec)
+}
 }
