@@ -521,6 +521,30 @@ mod tests {
         assert_eq!(m.uvs.as_ref().unwrap()[2], Vec2::ONE);
     }
 
+    /// Other properties become attributes, grouped and named as Mitsuba
+    /// names them; a face's values go to every triangle it is fanned into.
+    #[test]
+    fn vertex_and_face_properties_become_named_attributes() {
+        let text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+                    property float r\nproperty float g\nproperty float b\nproperty float temp\n\
+                    element face 2\nproperty list uchar int vertex_indices\nproperty float w_0\nproperty float w_1\n\
+                    property float q_x\nend_header\n\
+                    0 0 0 1 0 0 5\n1 0 0 0 1 0 6\n1 1 0 0 0 1 7\n0 1 0 1 1 1 8\n4 0 1 2 3 0.25 0.5 9\n3 0 1 2 1 2 3\n";
+        let m = parse(text.as_bytes()).unwrap();
+        let names: Vec<(&str, bool, usize)> =
+            m.attributes.iter().map(|a| (a.name.as_str(), a.per_face, a.dim)).collect();
+        assert_eq!(
+            names,
+            [("vertex_color", false, 3), ("vertex_temp", false, 1), ("face_w", true, 2), ("face_q", true, 1)]
+        );
+        assert_eq!(m.attributes[0].color(1), Vec3::Y);
+        assert_eq!(m.attributes[1].color(3), Vec3::splat(8.0));
+        // The quad is two triangles with its values; then the triangle.
+        assert_eq!(m.triangles.len(), 3);
+        assert_eq!(m.attributes[2].values, [0.25, 0.5, 0.25, 0.5, 1.0, 2.0]);
+        assert_eq!(m.attributes[3].color(2), Vec3::splat(3.0));
+    }
+
     /// The same quad in binary, both byte orders, with a uchar colour.
     #[test]
     fn binary_files_of_either_byte_order_read_the_same() {

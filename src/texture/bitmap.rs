@@ -238,6 +238,18 @@ mod tests {
         assert_eq!(b.eval(Vec2::new(1.1, 0.1)).x, 3.0);
     }
 
+    /// The gradient of the bilinear lookup is its slope between texel
+    /// centres, per texel: the ramp rises by 1 per texel across x and by
+    /// 10 from row to row; nearest lookup is flat.
+    #[test]
+    fn the_gradient_is_the_ramps_slope() {
+        let mut b = ramp();
+        let g = b.gradient(Vec2::new(0.45, 0.25));
+        assert!((g - Vec2::new(1.0, 10.0)).length() < 1e-4, "{g}");
+        b.filter = Filter::Nearest;
+        assert_eq!(b.gradient(Vec2::new(0.45, 0.25)), Vec2::ZERO);
+    }
+
     #[test]
     fn srgb_decoding_matches_the_standard() {
         assert_eq!(srgb_to_linear(0.0), 0.0);

@@ -67,9 +67,11 @@ pub struct RenderArgs {
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     more_outputs: Vec<PathBuf>,
     /// Estimator: photon (photon mapping) or path (path tracing with
-    /// next-event estimation, unbiased: the reference).
-    #[arg(long, value_enum, default_value_t = IntegratorArg::Photon)]
-    integrator: IntegratorArg,
+    /// next-event estimation, unbiased: the reference). Default: photon;
+    /// path for a Mitsuba scene whose integrator stops paths at 3 or more
+    /// vertices (max_depth), which photon mapping cannot do.
+    #[arg(long, value_enum)]
+    integrator: Option<IntegratorArg>,
     /// Progressive rendering: passes 0 to N-1, averaged (with --resume:
     /// until the image holds N passes). Photon mapping narrows its
     /// estimates from pass to pass so the image converges to the true one.
@@ -266,6 +268,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
             .map_err(|e| Error::Invalid(format!("--threads: {e}")))?;
     }
 
+    let mut integrator = cli.integrator.unwrap_or(IntegratorArg::Photon);
     let loading = Instant::now();
     let wait = Wait::start(Mode::detect(cli.quiet), loading_line(cli.scene.as_deref()));
     let (mut scene, file_spp, scene_id) = match &cli.scene {
@@ -279,12 +282,26 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
                 photonmap::scene::mitsuba::Options { defines: cli.defines.clone(), substitute: cli.substitute };
             let mut imported =
                 photonmap::scene::mitsuba::load(path, &options).map_err(|e| Error::Invalid(e.to_string()))?;
-            if let (Some(e), IntegratorArg::Photon) = (imported.photon_limit.take(), cli.integrator) {
-                if !cli.substitute {
-                    return Err(Error::Invalid(e.to_string()));
+            match (imported.photon_limit.take(), cli.integrator) {
+                (Some(e), Some(IntegratorArg::Photon)) => {
+                    if !cli.substitute {
+                        return Err(Error::Invalid(e.to_string()));
+                    }
+                    imported.substitutions.push(format!("{e} (rendered with paths of every length)"));
+                    imported.file.parts.paths.max_depth = None;
                 }
-                imported.substitutions.push(format!("{e} (rendered with paths of every length)"));
-                imported.file.parts.paths.max_depth = None;
+                (Some(_), None) => {
+                    integrator = IntegratorArg::Path;
+                    if !cli.quiet {
+                        let depth = imported.file.parts.paths.max_depth.unwrap_or(0);
+                        eprintln!(
+                            "photonmap: {}: the integrator's max_depth {depth} stops paths at {depth} vertices, which \
+                             the path tracer does exactly and photon mapping cannot: rendering with --integrator path",
+                            path.display()
+                        );
+                    }
+                }
+                _ => {}
             }
             for s in &imported.substitutions {
                 eprintln!("substituted: {s}");
@@ -335,7 +352,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
     if let Some(path) = &cli.reference {
         reference_shows(path, &scene_id, cli.quiet)?;
     }
-    if cli.integrator == IntegratorArg::Path {
+    if integrator == IntegratorArg::Path {
         path_tracer_sees(&scene, cli.quiet)?;
     }
 
@@ -349,7 +366,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
         false => (cli.photons.unwrap_or(DEFAULT.photons), cli.spp.unwrap_or(file_spp)),
     };
     let settings = Settings {
-        method: match cli.integrator {
+        method: match integrator {
             IntegratorArg::Photon => Method::Photon,
             IntegratorArg::Path => Method::Path,
         },

@@ -420,6 +420,26 @@ mod tests {
         assert!((area - 24.0).abs() < 1e-5);
     }
 
+    /// Each face of the cube maps onto the unit square: its corners take
+    /// the four corners of [0, 1]^2, and u and v run along its edges.
+    #[test]
+    fn the_cubes_faces_each_map_onto_the_unit_square() {
+        let (tris, uvs) = cube();
+        for face in 0..6 {
+            let (t, uv) = (&tris[2 * face..2 * face + 2], &uvs[2 * face..2 * face + 2]);
+            let mut corners: Vec<[i32; 2]> = uv.iter().flatten().map(|c| [c.x as i32, c.y as i32]).collect();
+            corners.sort();
+            corners.dedup();
+            assert_eq!(corners, [[0, 0], [0, 1], [1, 0], [1, 1]], "face {face}");
+            // The same uv is the same point in both triangles.
+            for (p, c) in t[0].iter().zip(&uv[0]) {
+                for (q, d) in t[1].iter().zip(&uv[1]) {
+                    assert_eq!(p == q, c == d, "face {face}");
+                }
+            }
+        }
+    }
+
     /// A flat fan gets the plane's normal at every corner; a corner of a
     /// cube gets the diagonal.
     #[test]
