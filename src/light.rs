@@ -12,8 +12,8 @@ use crate::envmap::EnvMap;
 use crate::math::{Color, Frame, Ray, Vertex};
 use crate::sampling::{concentric_disk, cosine_hemisphere, uniform_cone, uniform_triangle};
 use crate::shape::{Departure, Disk, Triangle};
-use glam::{Vec2, Vec3};
 use crate::texture::{SurfacePoint, Texture};
+use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 use std::sync::Arc;
 
@@ -308,7 +308,8 @@ impl Spot {
             let falloff = self.falloff(theta.cos() as f32) as f64;
             for j in 0..np {
                 let phi = (j as f64 + 0.5) / np as f64 * 2.0 * std::f64::consts::PI;
-                let l = Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32);
+                let l =
+                    Vec3::new((theta.sin() * phi.cos()) as f32, (theta.sin() * phi.sin()) as f32, theta.cos() as f32);
                 sum += spot_texel(&texture, l, self.cutoff).as_dvec3() * falloff * w;
             }
         }

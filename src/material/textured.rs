@@ -50,14 +50,34 @@ impl Param {
 /// Mitsuba's BSDFs with their texturable parameters.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Textured {
-    Diffuse { reflectance: Param },
+    Diffuse {
+        reflectance: Param,
+    },
     /// Mitsuba's `mask` over a diffuse BSDF.
-    Mask { opacity: Param, reflectance: Param },
+    Mask {
+        opacity: Param,
+        reflectance: Param,
+    },
     /// Mitsuba's `blendbsdf` of two diffuse BSDFs: a diffuse BSDF of the
     /// reflectances mixed by `weight` (0 is the first).
-    DiffuseBlend { weight: Param, first: Param, second: Param },
-    Conductor { eta: Color, k: Color, specular: Param },
-    RoughConductor { distribution: Distribution, alpha_u: Param, alpha_v: Param, eta: Color, k: Color, specular: Param },
+    DiffuseBlend {
+        weight: Param,
+        first: Param,
+        second: Param,
+    },
+    Conductor {
+        eta: Color,
+        k: Color,
+        specular: Param,
+    },
+    RoughConductor {
+        distribution: Distribution,
+        alpha_u: Param,
+        alpha_v: Param,
+        eta: Color,
+        k: Color,
+        specular: Param,
+    },
     RoughDielectric {
         distribution: Distribution,
         alpha_u: Param,
@@ -67,7 +87,13 @@ pub enum Textured {
         reflectance: Param,
         transmittance: Param,
     },
-    Plastic { diffuse: Param, specular: Param, int_ior: f32, ext_ior: f32, nonlinear: bool },
+    Plastic {
+        diffuse: Param,
+        specular: Param,
+        int_ior: f32,
+        ext_ior: f32,
+        nonlinear: bool,
+    },
     RoughPlastic {
         distribution: Distribution,
         alpha: f32,
@@ -115,10 +141,9 @@ impl Textured {
         let alpha = |p: Param| number(p).clamp(0.0, 10.0);
         match *self {
             Textured::Diffuse { reflectance } => Material::Lambertian { rho: unit(reflectance) },
-            Textured::Mask { opacity, reflectance } => Material::Masked(super::Masked {
-                opacity: number(opacity).clamp(0.0, 1.0),
-                rho: unit(reflectance),
-            }),
+            Textured::Mask { opacity, reflectance } => {
+                Material::Masked(super::Masked { opacity: number(opacity).clamp(0.0, 1.0), rho: unit(reflectance) })
+            }
             Textured::DiffuseBlend { weight, first, second } => {
                 let w = number(weight).clamp(0.0, 1.0);
                 Material::Lambertian { rho: unit(first) * (1.0 - w) + unit(second) * w }
@@ -127,17 +152,23 @@ impl Textured {
             Textured::RoughConductor { distribution, alpha_u, alpha_v, eta, k, specular } => {
                 Material::rough_conductor(distribution, alpha(alpha_u), alpha(alpha_v), eta, k, unit(specular))
             }
-            Textured::RoughDielectric { distribution, alpha_u, alpha_v, int_ior, ext_ior, reflectance, transmittance } => {
-                Material::rough_dielectric(
-                    distribution,
-                    alpha(alpha_u),
-                    alpha(alpha_v),
-                    int_ior,
-                    ext_ior,
-                    unit(reflectance),
-                    unit(transmittance),
-                )
-            }
+            Textured::RoughDielectric {
+                distribution,
+                alpha_u,
+                alpha_v,
+                int_ior,
+                ext_ior,
+                reflectance,
+                transmittance,
+            } => Material::rough_dielectric(
+                distribution,
+                alpha(alpha_u),
+                alpha(alpha_v),
+                int_ior,
+                ext_ior,
+                unit(reflectance),
+                unit(transmittance),
+            ),
             Textured::Plastic { diffuse, specular, int_ior, ext_ior, nonlinear } => {
                 Material::plastic(unit(diffuse), unit(specular), int_ior, ext_ior, nonlinear)
             }

@@ -192,7 +192,8 @@ mod tests {
     /// corner; none where a corner lacks them.
     #[test]
     fn texture_coordinates_follow_the_corners() {
-        let m = load("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1 0\nvt 0 1\nf 1/1 2/2 3/3 4/4\n").unwrap();
+        let m =
+            load("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1 0\nvt 0 1\nf 1/1 2/2 3/3 4/4\n").unwrap();
         let uvs = m.uvs.expect("every corner has one");
         assert_eq!(uvs, [[Vec2::ZERO, Vec2::X, Vec2::ONE], [Vec2::ZERO, Vec2::ONE, Vec2::Y]]);
         assert!(load("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/1 2 3\n").unwrap().uvs.is_none());

@@ -240,7 +240,11 @@ impl Texturing {
     #[inline]
     pub fn point(&self, hit: &Hit) -> crate::texture::SurfacePoint {
         let surface = self.surfaces.get(hit.prim as usize).copied().unwrap_or(crate::texture::SurfaceUv::Barycentric);
-        crate::texture::SurfacePoint { uv: surface.uv(hit.point, hit.bary, &self.frames), prim: hit.prim, bary: hit.bary }
+        crate::texture::SurfacePoint {
+            uv: surface.uv(hit.point, hit.bary, &self.frames),
+            prim: hit.prim,
+            bary: hit.bary,
+        }
     }
 }
 

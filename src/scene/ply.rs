@@ -53,7 +53,8 @@ impl Attribute {
 /// Groups the properties at `candidates` (index, name) into attributes:
 /// (name without the element's prefix, property indices).
 fn group_attributes(candidates: &[(usize, String)]) -> Vec<(String, Vec<usize>)> {
-    const SCHEMES: [[&str; 4]; 4] = [["x", "y", "z", "w"], ["r", "g", "b", "a"], ["0", "1", "2", "3"], ["1", "2", "3", "4"]];
+    const SCHEMES: [[&str; 4]; 4] =
+        [["x", "y", "z", "w"], ["r", "g", "b", "a"], ["0", "1", "2", "3"], ["1", "2", "3", "4"]];
     const COLOURS: [[&str; 4]; 2] = [["r", "g", "b", "a"], ["red", "green", "blue", "alpha"]];
     let mut out = Vec::new();
     let mut i = 0;
@@ -292,7 +293,8 @@ fn read_vertices(e: &Element, body: &mut Body, mesh: &mut PlyMesh) -> Result<(),
     let has_normals = normal.iter().all(Option::is_some);
     let has_uv = uv.iter().all(Option::is_some);
     let has_color = color.iter().all(Option::is_some);
-    let reserved = ["x", "y", "z", "nx", "ny", "nz", "u", "v", "s", "t", "texture_u", "texture_s", "texture_v", "texture_t"];
+    let reserved =
+        ["x", "y", "z", "nx", "ny", "nz", "u", "v", "s", "t", "texture_u", "texture_s", "texture_v", "texture_t"];
     let candidates: Vec<(usize, String)> = e
         .properties
         .iter()
@@ -305,7 +307,12 @@ fn read_vertices(e: &Element, body: &mut Body, mesh: &mut PlyMesh) -> Result<(),
     let groups = group_attributes(&candidates);
     let first = mesh.attributes.len();
     for (name, ix) in &groups {
-        mesh.attributes.push(Attribute { name: format!("vertex_{name}"), per_face: false, dim: ix.len(), values: Vec::new() });
+        mesh.attributes.push(Attribute {
+            name: format!("vertex_{name}"),
+            per_face: false,
+            dim: ix.len(),
+            values: Vec::new(),
+        });
     }
     let mut values = vec![0f64; e.properties.len()];
     let (mut normals, mut uvs, mut colors) = (Vec::new(), Vec::new(), Vec::new());
@@ -376,7 +383,12 @@ fn read_faces(e: &Element, body: &mut Body, mesh: &mut PlyMesh) -> Result<(), St
     let groups = group_attributes(&candidates);
     let first = mesh.attributes.len();
     for (name, ix) in &groups {
-        mesh.attributes.push(Attribute { name: format!("face_{name}"), per_face: true, dim: ix.len(), values: Vec::new() });
+        mesh.attributes.push(Attribute {
+            name: format!("face_{name}"),
+            per_face: true,
+            dim: ix.len(),
+            values: Vec::new(),
+        });
     }
     let mut values = vec![0f64; e.properties.len()];
     let mut polygon = Vec::new();

@@ -33,13 +33,23 @@ pub struct SurfacePoint {
 pub enum Texture {
     /// One value everywhere (Mitsuba's `rawconstant`).
     Constant(Color),
-    Bitmap { image: Arc<Bitmap>, to_uv: Affine2 },
+    Bitmap {
+        image: Arc<Bitmap>,
+        to_uv: Affine2,
+    },
     /// Squares of `color0` and `color1`, two by two per unit of uv.
-    Checkerboard { color0: Color, color1: Color, to_uv: Affine2 },
+    Checkerboard {
+        color0: Color,
+        color1: Color,
+        to_uv: Affine2,
+    },
     /// A mesh attribute: per primitive, its value at the three corners (a
     /// face attribute's three are equal), zero for primitives without it;
     /// interpolated with the barycentrics.
-    Attribute { values: Arc<Vec<[Color; 3]>>, scale: f32 },
+    Attribute {
+        values: Arc<Vec<[Color; 3]>>,
+        scale: f32,
+    },
 }
 
 impl Texture {

@@ -69,120 +69,125 @@ impl Builder<'_> {
         }
     }
 
-fn light_of(&mut self, p: &Plugin) -> Result<LightSpec, SceneError> {
-    let spec = match p.kind {
-        "point" => {
-            let position = match (p.point("position")?, p.transform("to_world")?) {
-                (Some(_), Some(_)) => return Err(p.refuse("give either position or to_world, not both")),
-                (Some(x), None) => x,
-                (None, m) => m.unwrap_or(DAffine3::IDENTITY).translation,
-            };
-            let intensity = p.color("intensity", Use::Emission)?.unwrap_or(Color::ONE);
-            p.finish("position, to_world, intensity")?;
-            LightSpec::Point { position: position.as_vec3(), intensity, falloff: 2.0, dead_distance: 0.0 }
-        }
-        "directional" => {
-            let direction = match (p.point("direction")?, p.transform("to_world")?) {
-                (Some(_), Some(_)) => return Err(p.refuse("give either direction or to_world, not both")),
-                (Some(d), None) => d,
-                (None, m) => m.unwrap_or(DAffine3::IDENTITY).transform_vector3(DVec3::Z),
-            };
-            let direction =
-                direction.try_normalize().ok_or_else(|| p.fail(p.loc(), "direction", "must not be zero"))?.as_vec3();
-            let irradiance = p.color("irradiance", Use::Emission)?.unwrap_or(Color::ONE);
-            p.finish("direction, to_world, irradiance")?;
-            LightSpec::Directional { direction, irradiance }
-        }
-        "spot" => {
-            let m = p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
-            let intensity = p.color("intensity", Use::Emission)?.unwrap_or(Color::ONE);
-            let cutoff = p.float_in("cutoff_angle", 20.0, 1e-3, 180.0)?;
-            let beam = p.float_in("beam_width", cutoff * 0.75, 0.0, 180.0)?;
-            let texture = match p.value("texture", Use::Reflectance)? {
-                None => None,
-                Some(Value::Texture(t)) => Some(self.emitter_texture(&t)?),
-                Some(Value::Color(c)) => Some(std::sync::Arc::new(crate::texture::Texture::Constant(c))),
-            };
-            p.finish("to_world, intensity, cutoff_angle, beam_width, texture")?;
-            let axis = m
-                .transform_vector3(DVec3::Z)
-                .try_normalize()
-                .ok_or_else(|| p.fail(p.loc(), "to_world", "is singular"))?;
-            let pattern = match texture {
-                None => None,
-                Some(t) => {
-                    let x = m.transform_vector3(DVec3::X);
-                    let x = (x - axis * x.dot(axis)).try_normalize().ok_or_else(|| p.fail(p.loc(), "to_world", "is singular"))?;
-                    Some((t, x.as_vec3(), axis.cross(x).as_vec3()))
+    fn light_of(&mut self, p: &Plugin) -> Result<LightSpec, SceneError> {
+        let spec = match p.kind {
+            "point" => {
+                let position = match (p.point("position")?, p.transform("to_world")?) {
+                    (Some(_), Some(_)) => return Err(p.refuse("give either position or to_world, not both")),
+                    (Some(x), None) => x,
+                    (None, m) => m.unwrap_or(DAffine3::IDENTITY).translation,
+                };
+                let intensity = p.color("intensity", Use::Emission)?.unwrap_or(Color::ONE);
+                p.finish("position, to_world, intensity")?;
+                LightSpec::Point { position: position.as_vec3(), intensity, falloff: 2.0, dead_distance: 0.0 }
+            }
+            "directional" => {
+                let direction = match (p.point("direction")?, p.transform("to_world")?) {
+                    (Some(_), Some(_)) => return Err(p.refuse("give either direction or to_world, not both")),
+                    (Some(d), None) => d,
+                    (None, m) => m.unwrap_or(DAffine3::IDENTITY).transform_vector3(DVec3::Z),
+                };
+                let direction = direction
+                    .try_normalize()
+                    .ok_or_else(|| p.fail(p.loc(), "direction", "must not be zero"))?
+                    .as_vec3();
+                let irradiance = p.color("irradiance", Use::Emission)?.unwrap_or(Color::ONE);
+                p.finish("direction, to_world, irradiance")?;
+                LightSpec::Directional { direction, irradiance }
+            }
+            "spot" => {
+                let m = p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
+                let intensity = p.color("intensity", Use::Emission)?.unwrap_or(Color::ONE);
+                let cutoff = p.float_in("cutoff_angle", 20.0, 1e-3, 180.0)?;
+                let beam = p.float_in("beam_width", cutoff * 0.75, 0.0, 180.0)?;
+                let texture = match p.value("texture", Use::Reflectance)? {
+                    None => None,
+                    Some(Value::Texture(t)) => Some(self.emitter_texture(&t)?),
+                    Some(Value::Color(c)) => Some(std::sync::Arc::new(crate::texture::Texture::Constant(c))),
+                };
+                p.finish("to_world, intensity, cutoff_angle, beam_width, texture")?;
+                let axis = m
+                    .transform_vector3(DVec3::Z)
+                    .try_normalize()
+                    .ok_or_else(|| p.fail(p.loc(), "to_world", "is singular"))?;
+                let pattern = match texture {
+                    None => None,
+                    Some(t) => {
+                        let x = m.transform_vector3(DVec3::X);
+                        let x = (x - axis * x.dot(axis))
+                            .try_normalize()
+                            .ok_or_else(|| p.fail(p.loc(), "to_world", "is singular"))?;
+                        Some((t, x.as_vec3(), axis.cross(x).as_vec3()))
+                    }
+                };
+                LightSpec::Spot {
+                    position: m.translation.as_vec3(),
+                    axis: axis.as_vec3(),
+                    intensity,
+                    cutoff_deg: cutoff as f32,
+                    beam_deg: beam.min(cutoff) as f32,
+                    pattern,
                 }
-            };
-            LightSpec::Spot {
-                position: m.translation.as_vec3(),
-                axis: axis.as_vec3(),
-                intensity,
-                cutoff_deg: cutoff as f32,
-                beam_deg: beam.min(cutoff) as f32,
-                pattern,
+            }
+            "projector" => {
+                let m = p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
+                let (irradiance, pattern) = match p.value("irradiance", Use::Emission)? {
+                    None => (Color::ONE, None),
+                    Some(Value::Color(c)) => (c, None),
+                    Some(Value::Texture(t)) => (Color::ONE, Some(self.emitter_texture(&t)?)),
+                };
+                let scale = p.float_in("scale", 1.0, 0.0, 1e30)?;
+                // The window has the image's aspect (a constant irradiance is
+                // a 1 x 1 image: a square frustum).
+                let aspect = match pattern.as_deref() {
+                    Some(crate::texture::Texture::Bitmap { image, .. }) => {
+                        let r = image.resolution();
+                        (r.x / r.y) as f64
+                    }
+                    _ => 1.0,
+                };
+                let x_fov = super::sensor::fov(p, aspect)?;
+                p.finish("to_world, irradiance, scale, fov, fov_axis")?;
+                let axes = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis];
+                let Some(axes) =
+                    axes.iter().map(|a| a.try_normalize().map(|a| a.as_vec3())).collect::<Option<Vec<_>>>()
+                else {
+                    return Err(p.fail(p.loc(), "to_world", "is singular"));
+                };
+                let t = (0.5 * x_fov.to_radians()).tan();
+                let pattern = pattern.map(|t| {
+                    let mean = crate::light::Projector::window_mean(&t);
+                    (t, mean)
+                });
+                LightSpec::Projector(crate::light::Projector {
+                    position: m.translation.as_vec3(),
+                    axes: [axes[0], axes[1], axes[2]],
+                    scaled: irradiance * (std::f32::consts::PI * scale as f32),
+                    tan_x: t as f32,
+                    tan_y: (t / aspect) as f32,
+                    pattern,
+                })
+            }
+            "area" => return Err(p.refuse("an area emitter must be nested in the <shape> that emits")),
+            "constant" => {
+                let radiance = p.color("radiance", Use::Emission)?.unwrap_or(Color::ONE);
+                p.finish("radiance")?;
+                LightSpec::Constant { radiance }
+            }
+            k => {
+                return Err(p.refuse(format!(
+                    "the '{k}' emitter is not supported yet (point, directional, spot, constant and area are)"
+                )))
+            }
+        };
+        if let LightSpec::Point { intensity: c, .. }
+        | LightSpec::Spot { intensity: c, .. }
+        | LightSpec::Directional { irradiance: c, .. } = spec
+        {
+            if c.min_element() < 0.0 {
+                return Err(p.refuse("emission must not be negative"));
             }
         }
-        "projector" => {
-            let m = p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
-            let (irradiance, pattern) = match p.value("irradiance", Use::Emission)? {
-                None => (Color::ONE, None),
-                Some(Value::Color(c)) => (c, None),
-                Some(Value::Texture(t)) => (Color::ONE, Some(self.emitter_texture(&t)?)),
-            };
-            let scale = p.float_in("scale", 1.0, 0.0, 1e30)?;
-            // The window has the image's aspect (a constant irradiance is
-            // a 1 x 1 image: a square frustum).
-            let aspect = match pattern.as_deref() {
-                Some(crate::texture::Texture::Bitmap { image, .. }) => {
-                    let r = image.resolution();
-                    (r.x / r.y) as f64
-                }
-                _ => 1.0,
-            };
-            let x_fov = super::sensor::fov(p, aspect)?;
-            p.finish("to_world, irradiance, scale, fov, fov_axis")?;
-            let axes = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis];
-            let Some(axes) = axes.iter().map(|a| a.try_normalize().map(|a| a.as_vec3())).collect::<Option<Vec<_>>>()
-            else {
-                return Err(p.fail(p.loc(), "to_world", "is singular"));
-            };
-            let t = (0.5 * x_fov.to_radians()).tan();
-            let pattern = pattern.map(|t| {
-                let mean = crate::light::Projector::window_mean(&t);
-                (t, mean)
-            });
-            LightSpec::Projector(crate::light::Projector {
-                position: m.translation.as_vec3(),
-                axes: [axes[0], axes[1], axes[2]],
-                scaled: irradiance * (std::f32::consts::PI * scale as f32),
-                tan_x: t as f32,
-                tan_y: (t / aspect) as f32,
-                pattern,
-            })
-        }
-        "area" => return Err(p.refuse("an area emitter must be nested in the <shape> that emits")),
-        "constant" => {
-            let radiance = p.color("radiance", Use::Emission)?.unwrap_or(Color::ONE);
-            p.finish("radiance")?;
-            LightSpec::Constant { radiance }
-        }
-        k => {
-            return Err(p.refuse(format!(
-                "the '{k}' emitter is not supported yet (point, directional, spot, constant and area are)"
-            )))
-        }
-    };
-    if let LightSpec::Point { intensity: c, .. }
-    | LightSpec::Spot { intensity: c, .. }
-    | LightSpec::Directional { irradiance: c, .. } = spec
-    {
-        if c.min_element() < 0.0 {
-            return Err(p.refuse("emission must not be negative"));
-        }
+        Ok(spec)
     }
-    Ok(spec)
-}
 }

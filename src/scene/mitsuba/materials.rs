@@ -8,9 +8,9 @@ use super::props::Plugin;
 use super::spectrum::{named_ior, Use};
 use super::Builder;
 use crate::material::{Distribution, Material, Param, Textured};
-use crate::texture::Perturb;
 use crate::math::Color;
 use crate::scene::file::SceneError;
+use crate::texture::Perturb;
 
 /// A material, its textured recipe where it reads textures, whether it is
 /// one-sided, and how it bends the shading normal.

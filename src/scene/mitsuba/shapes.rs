@@ -361,7 +361,9 @@ fn affine(m: &DAffine3) -> Affine3A {
 fn cube() -> (Vec<[Vec3; 3]>, Vec<[Vec2; 3]>) {
     const CORNERS: [u32; 24] = [1, 5, 4, 0, 3, 2, 6, 7, 1, 3, 7, 5, 5, 7, 6, 4, 4, 6, 2, 0, 3, 1, 0, 2];
     let uv = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]].map(Vec2::from_array);
-    let corner = |c: u32| Vec3::new([-1.0, 1.0][(c & 1) as usize], [-1.0, 1.0][(c >> 1 & 1) as usize], [-1.0, 1.0][(c >> 2 & 1) as usize]);
+    let corner = |c: u32| {
+        Vec3::new([-1.0, 1.0][(c & 1) as usize], [-1.0, 1.0][(c >> 1 & 1) as usize], [-1.0, 1.0][(c >> 2 & 1) as usize])
+    };
     let (mut tris, mut uvs) = (Vec::new(), Vec::new());
     for side in 0..6 {
         let v = |k: usize| corner(CORNERS[4 * side + k]);

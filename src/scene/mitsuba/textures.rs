@@ -94,7 +94,9 @@ impl Builder<'_> {
                     Some("vector" | "point") => t.point("value")?.unwrap_or(glam::DVec3::ONE).as_vec3(),
                     _ => match t.value("value", Use::Unbounded)? {
                         Some(Value::Color(c)) => c,
-                        Some(Value::Texture(inner)) => return Err(inner.refuse("a rawconstant's value must be numbers")),
+                        Some(Value::Texture(inner)) => {
+                            return Err(inner.refuse("a rawconstant's value must be numbers"))
+                        }
                         None => Color::ONE,
                     },
                 };
