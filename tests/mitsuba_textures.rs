@@ -150,8 +150,7 @@ fn mesh_attributes_and_blends_colour_each_face() {
 #[test]
 fn a_mask_lets_the_rest_through() {
     let dir = scratch_dir("mitsuba_mask");
-    let text = format!(
-        r#"<scene version="3.0.0">
+    let text = r#"<scene version="3.0.0">
   <sensor type="perspective"><float name="fov" value="40"/>
     <transform name="to_world"><lookat origin="0,0,2" target="0,0,0" up="0,1,0"/></transform>
     <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film>
@@ -162,9 +161,8 @@ fn a_mask_lets_the_rest_through() {
     <bsdf type="mask"><float name="opacity" value="0.25"/>
       <bsdf type="twosided"><bsdf type="diffuse"><rgb name="reflectance" value="0.2"/></bsdf></bsdf></bsdf></shape>
   <emitter type="directional"><vector name="direction" value="1,0,-1"/><rgb name="irradiance" value="2"/></emitter>
-</scene>"#
-    );
-    let film = render(&write(&dir, "m.xml", &text), Method::Photon).unwrap();
+</scene>"#;
+    let film = render(&write(&dir, "m.xml", text), Method::Photon).unwrap();
     let cos = std::f64::consts::FRAC_1_SQRT_2;
     let want = (0.25 * 0.2 + 0.75 * 0.6) * 2.0 * cos / PI;
     let centre: f64 =
@@ -238,7 +236,7 @@ fn texture_refusals_are_located() {
     image::GrayImage::from_raw(1, 1, vec![7]).unwrap().save(dir.join("t.png")).unwrap();
     for (bsdf, said) in cases {
         let f = write(&dir, "r.xml", &plane(bsdf, ""));
-        let e = render(&f, Method::Photon).err().expect("refused");
+        let e = render(&f, Method::Photon).expect_err("refused");
         assert!(e.contains("r.xml:") && e.contains(said), "{bsdf}: {e}");
     }
 }

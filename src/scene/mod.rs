@@ -368,7 +368,7 @@ impl SceneParts {
         }
         let shrink = glam::Affine3A::from_scale(Vec3::splat(1.0 / s));
         for f in &mut self.texturing.frames {
-            *f = *f * shrink;
+            *f *= shrink;
         }
         self.camera = self.camera.scaled(s);
         self
