@@ -1,10 +1,40 @@
-//! The course's pinhole camera: an eye point and an image plane given by its
-//! four corners; a pixel's sample points are bilinear in the corners, and the
-//! pixel value is the box-filtered radiance through the pixel's square.
+//! The course's camera: an eye point and an image plane given by its four
+//! corners; a pixel's sample points are bilinear in the corners, and the
+//! pixel value is the filtered radiance through the pixel's square. How a
+//! point of the plane becomes a ray is the camera's [`Projection`]: through
+//! the eye (the course's pinhole), through a thin lens, or straight along
+//! the view (orthographic).
 
 use crate::filter::Filter;
-use crate::math::{Ray, Vertex};
+use crate::math::{Direction, Ray, Vertex};
+use crate::sampling::concentric_disk;
 use glam::{Vec2, Vec3};
+
+/// How the image plane's points become rays.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Every ray leaves the eye through its point of the plane (infinite
+    /// depth of field).
+    Pinhole,
+    /// A thin lens of radius `radius` centred on the eye, in the plane
+    /// parallel to the image plane; it brings the plane at distance `focus`
+    /// (along the view axis) into focus. A ray leaves a point of the lens
+    /// towards where the pinhole ray through its point of the plane meets
+    /// the plane in focus, so points there are sharp and others blur into
+    /// discs (Mitsuba 3's `thinlens`, src/sensors/thinlens.cpp; pbrt's
+    /// thin-lens camera).
+    ThinLens { radius: f32, focus: f32 },
+    /// Every ray leaves its point of the plane along `dir`: the plane is the
+    /// view's extent, the eye only its centre (Mitsuba 3's `orthographic`).
+    Orthographic { dir: Direction },
+}
+
+impl Projection {
+    /// Whether a ray needs a point of the lens as well as of the plane.
+    pub fn has_lens(&self) -> bool {
+        matches!(self, Projection::ThinLens { .. })
+    }
+}
 
 #[derive(Clone, Copy, Debug)]
 pub struct Camera {
@@ -23,9 +53,12 @@ pub struct Camera {
     /// Where a pixel's samples land about its centre (the course's box by
     /// default).
     pub filter: Filter,
-    /// Rays start this far from the eye along the view axis (a near clip
-    /// plane, as in Mitsuba's sensors); 0: at the eye.
+    /// Rays start this far from the eye (or the lens) along the view axis
+    /// (a near clip plane, as in Mitsuba's sensors); 0: at the eye. An
+    /// orthographic camera's rays start on the image plane itself, and its
+    /// near clip is where that plane is put.
     pub near: f32,
+    pub projection: Projection,
 }
 
 impl Camera {
@@ -45,6 +78,7 @@ impl Camera {
             widens: false,
             filter: Filter::Box,
             near: 0.0,
+            projection: Projection::Pinhole,
         }
     }
 
@@ -142,23 +176,59 @@ impl Camera {
         self.upper_left *= s;
         self.across *= s;
         self.down *= s;
+        self.near *= s;
+        if let Projection::ThinLens { radius, focus } = self.projection {
+            self.projection = Projection::ThinLens { radius: radius * s, focus: focus * s };
+        }
         self
     }
 
-    /// The ray through image position (`col` + u.x, `row` + u.y), row 0 at the top.
+    /// The view axis: the image plane's unit normal, on the side away from
+    /// the eye.
+    pub fn axis(&self) -> Direction {
+        let axis = self.across.cross(self.down).normalize();
+        if axis.dot(self.upper_left - self.eye) < 0.0 {
+            -axis
+        } else {
+            axis
+        }
+    }
+
+    /// The ray through image position (`col` + u.x, `row` + u.y), row 0 at
+    /// the top, through the lens's centre: the chief ray, which is the
+    /// only ray of a camera without a lens.
     pub fn ray(&self, col: u32, row: u32, u: Vec2) -> Ray {
+        self.sample_ray(col, row, u, Vec2::splat(0.5))
+    }
+
+    /// The ray through image position (`col` + u.x, `row` + u.y) and the
+    /// point of the lens that `lens` in [0, 1)^2 picks, uniformly by area
+    /// over the lens (ignored where the projection has none). The ray's
+    /// direction is a unit vector.
+    pub fn sample_ray(&self, col: u32, row: u32, u: Vec2, lens: Vec2) -> Ray {
         let u = self.filter.place(u);
         let fx = (col as f32 + u.x) / self.width as f32;
         let fy = (row as f32 + u.y) / self.height as f32;
         let p = self.upper_left + fx * self.across + fy * self.down;
-        let dir = (p - self.eye).normalize();
-        if self.near > 0.0 {
-            // The view axis is the plane's normal, towards the plane.
-            let axis = self.across.cross(self.down).normalize();
-            let axis = if axis.dot(self.upper_left - self.eye) < 0.0 { -axis } else { axis };
-            return Ray::new(self.eye + dir * (self.near / dir.dot(axis)), dir);
+        match self.projection {
+            Projection::Pinhole => {
+                let dir = (p - self.eye).normalize();
+                if self.near > 0.0 {
+                    return Ray::new(self.eye + dir * (self.near / dir.dot(self.axis())), dir);
+                }
+                Ray::new(self.eye, dir)
+            }
+            Projection::ThinLens { radius, focus } => {
+                let axis = self.axis();
+                let through = p - self.eye;
+                let in_focus = self.eye + through * (focus / through.dot(axis));
+                let d = concentric_disk(lens) * radius;
+                let on_lens = self.eye + d.x * self.across.normalize() + d.y * self.down.normalize();
+                let dir = (in_focus - on_lens).normalize();
+                Ray::new(on_lens + dir * (self.near / dir.dot(axis)), dir)
+            }
+            Projection::Orthographic { dir } => Ray::new(p, dir),
         }
-        Ray::new(self.eye, dir)
     }
 }
 
