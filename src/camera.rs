@@ -234,6 +234,7 @@ impl Camera {
 
 #[cfg(test)]
 mod tests {
+    use crate::sampling::{next_2d, stream, Domain};
     use crate::scene::{Eye, Scene};
     use glam::{Vec2, Vec3};
 
@@ -296,5 +297,90 @@ mod tests {
         assert!(square.fit(160, 160).is_ok());
         let err = square.fit(400, 200).unwrap_err();
         assert!(err.contains("400x400 or 200x200"), "{err}");
+    }
+
+    /// A camera 1 from a 2 x 2 plane (90° across), looking along +z.
+    fn square(projection: super::Projection) -> super::Camera {
+        let c = [
+            Vec3::new(1.0, -1.0, 1.0),
+            Vec3::new(-1.0, -1.0, 1.0),
+            Vec3::new(-1.0, 1.0, 1.0),
+            Vec3::new(1.0, 1.0, 1.0),
+        ];
+        super::Camera { projection, ..super::Camera::from_corners(Vec3::ZERO, c, 64, 64) }
+    }
+
+    /// Through a thin lens every ray of an image point passes through one
+    /// point of the plane in focus: the pinhole ray's point there. Its
+    /// chief ray is the pinhole's.
+    #[test]
+    fn thin_lens_rays_meet_in_the_plane_in_focus() {
+        use super::Projection;
+        let lens = square(Projection::ThinLens { radius: 0.3, focus: 4.0 });
+        let pinhole = square(Projection::Pinhole);
+        let mut rng = stream(3, Domain::Camera, 0);
+        for (col, row) in [(0u32, 0u32), (31, 40), (63, 5)] {
+            let u = next_2d(&mut rng);
+            let chief = pinhole.ray(col, row, u);
+            assert!((lens.ray(col, row, u).dir - chief.dir).length() < 1e-6);
+            let want = chief.at(4.0 / chief.dir.z);
+            let mut spread = 0.0f32;
+            for _ in 0..64 {
+                let r = lens.sample_ray(col, row, u, next_2d(&mut rng));
+                assert!(r.origin.z.abs() < 1e-6 && r.origin.truncate().length() <= 0.3 + 1e-6, "{}", r.origin);
+                assert!((r.dir.length() - 1.0).abs() < 1e-6);
+                let at = r.at((4.0 - r.origin.z) / r.dir.z);
+                assert!((at - want).length() < 1e-5, "{at} vs {want}");
+                spread = spread.max(r.origin.length());
+            }
+            assert!(spread > 0.2, "the lens is used: {spread}");
+        }
+        // A near clip moves the origins onto the plane z = near.
+        let near = super::Camera { near: 0.5, ..lens };
+        let r = near.sample_ray(10, 20, Vec2::splat(0.3), Vec2::new(0.9, 0.1));
+        assert!((r.origin.z - 0.5).abs() < 1e-6, "{}", r.origin);
+        // The same rays in a scene twice the size: lens and focus scale too.
+        let (a, b) = (
+            lens.sample_ray(5, 6, Vec2::splat(0.5), Vec2::new(0.2, 0.7)),
+            lens.scaled(2.0).sample_ray(5, 6, Vec2::splat(0.5), Vec2::new(0.2, 0.7)),
+        );
+        assert!((b.origin - 2.0 * a.origin).length() < 1e-5 && (b.dir - a.dir).length() < 1e-6);
+    }
+
+    /// Lens points are uniform by area over the lens: chi-square over 10 x
+    /// 10 cells equal in area (r^2 and angle).
+    #[test]
+    fn lens_points_are_uniform_on_the_lens() {
+        use super::Projection;
+        let lens = square(Projection::ThinLens { radius: 0.25, focus: 3.0 });
+        let mut rng = stream(7, Domain::Camera, 1);
+        let mut counts = [0u32; 100];
+        let n = 100_000;
+        for _ in 0..n {
+            let o = lens.sample_ray(20, 30, next_2d(&mut rng), next_2d(&mut rng)).origin / 0.25;
+            let a = ((o.x * o.x + o.y * o.y) * 10.0).min(9.999) as usize;
+            let b =
+                ((o.y.atan2(o.x).rem_euclid(std::f32::consts::TAU) / std::f32::consts::TAU) * 10.0).min(9.999) as usize;
+            counts[a * 10 + b] += 1;
+        }
+        let expected = n as f64 / 100.0;
+        let chi2: f64 = counts.iter().map(|&c| (c as f64 - expected).powi(2) / expected).sum();
+        // 99 degrees of freedom: p = 0.001 at 148.2.
+        assert!(chi2 < 148.2, "chi2 = {chi2}");
+    }
+
+    /// Orthographic rays are parallel and start on the plane, at the
+    /// pixel's point of it.
+    #[test]
+    fn orthographic_rays_start_on_the_plane() {
+        let dir = Vec3::new(0.0, 0.6, 0.8);
+        let ortho = square(super::Projection::Orthographic { dir });
+        for (col, row, u) in [(0u32, 0u32, Vec2::ZERO), (63, 63, Vec2::ONE), (16, 48, Vec2::splat(0.5))] {
+            let r = ortho.sample_ray(col, row, u, Vec2::new(0.9, 0.2));
+            let want = Vec3::new(2.0 * (col as f32 + u.x) / 64.0 - 1.0, 1.0 - 2.0 * (row as f32 + u.y) / 64.0, 1.0);
+            assert!((r.origin - want).length() < 1e-6, "{} vs {want}", r.origin);
+            assert_eq!(r.dir, dir);
+        }
+        assert!(!super::Projection::Orthographic { dir }.has_lens());
     }
 }
