@@ -28,8 +28,14 @@ fn read(path: &Path) -> Result<Scene, String> {
 /// The scene by path tracing (the camera sees only emitters here: every
 /// sample is exactly their radiance or zero).
 fn render(scene: &Scene, spp: u32) -> Film {
+    render_by(Method::Path, scene, spp)
+}
+
+fn render_by(method: Method, scene: &Scene, spp: u32) -> Film {
     let settings = Settings {
-        method: Method::Path,
+        method,
+        photons: 10_000,
+        caustic_photons: 0,
         spp,
         width: scene.camera.width,
         height: scene.camera.height,
@@ -68,7 +74,10 @@ fn an_orthographic_view_spans_its_scale() {
             glowing_rectangle(hx, hy, cx, cy, 5.0)
         )
     };
-    let film = render(&read(&write(&dir, "o.xml", &text(""))).unwrap(), 4);
+    let scene = read(&write(&dir, "o.xml", &text(""))).unwrap();
+    let film = render(&scene, 4);
+    // Photon mapping's camera pass takes the same rays.
+    assert_eq!(render_by(Method::Photon, &scene, 4), film);
     let mut lit = 0;
     for row in 0..20 {
         for col in 0..40 {
