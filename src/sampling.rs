@@ -175,6 +175,16 @@ pub fn sobol_owen_2d(index: u32, scramble: u64) -> Vec2 {
     Vec2::new(unit(owen_scramble(x, scramble as u32)), unit(owen_scramble(y, (scramble >> 32) as u32)))
 }
 
+/// `index` shuffled by nested uniform scrambling of its bits (Burley 2020,
+/// "Practical Hash-based Owen Scrambling", JCGT 9(4), section 4): each
+/// aligned block of 2^m indices goes to an aligned block of 2^m, so a
+/// sequence read through the shuffle keeps its strata, and its points are
+/// paired at random with those of a sequence read in order (a pixel's lens
+/// points with its positions on the film).
+pub fn shuffled_index(index: u32, seed: u32) -> u32 {
+    owen_scramble(index, seed)
+}
+
 /// Nested uniform scrambling of the bits of `x` (each bit flipped by a
 /// hash of the bits above it): the Laine–Karras permutation on the
 /// reversed bits.
@@ -443,5 +453,38 @@ mod tests {
         }
         assert!((rest / n as f64 - 0.5).abs() < 1e-3);
         assert!(Discrete::new([0.0, -1.0]).is_none() && Discrete::new([]).is_none());
+    }
+
+    /// The shuffle keeps aligned blocks together (a pass's samples stay one
+    /// stratum set), and pairs two sequences' points so that their joint
+    /// cells fill evenly: read in order, both would put their k-th points in
+    /// the same column, filling only the diagonal of a grid.
+    #[test]
+    fn a_shuffled_index_keeps_blocks_and_decorrelates() {
+        for m in [2u32, 4, 7] {
+            for block in [0u32, 1, 5, 1000] {
+                let mut got: Vec<u32> = (0..1 << m).map(|i| shuffled_index((block << m) + i, 0x5EED_1234)).collect();
+                let first = got[0] >> m;
+                assert!(got.iter().all(|&g| g >> m == first), "m {m} block {block}: {got:?}");
+                got.sort_unstable();
+                got.dedup();
+                assert_eq!(got.len(), 1 << m);
+            }
+        }
+        // 4096 pairs (x of the sequence in order, x of the shuffled one) in
+        // a 16 x 16 grid: 16 per cell if independent.
+        let (a, b) = (0x1234_5678_9ABC_DEF0u64, 0x0FED_CBA9_8765_4321u64);
+        let mut counts = vec![0u32; 256];
+        let mut diagonal = vec![0u32; 256];
+        for i in 0..4096u32 {
+            let x = sobol_owen_2d(i, a).x;
+            let y = sobol_owen_2d(shuffled_index(i, b as u32), b).x;
+            let y_in_order = sobol_owen_2d(i, b).x;
+            counts[(x * 16.0) as usize * 16 + (y * 16.0) as usize] += 1;
+            diagonal[(x * 16.0) as usize * 16 + (y_in_order * 16.0) as usize] += 1;
+        }
+        let chi2 = chi_square(&counts);
+        assert!(chi2 < 330.0, "chi2 = {chi2} (255 degrees of freedom, p = 0.001 at 330)");
+        assert!(chi_square(&diagonal) > 1000.0, "in order, the two are correlated");
     }
 }

@@ -1,9 +1,12 @@
 //! The same seed gives a bit-identical image whatever the number of threads;
 //! another seed gives another image. One harness, every configuration:
-//! photon mapping, path tracing, and progressive photon mapping.
+//! photon mapping, path tracing, and progressive photon mapping, through a
+//! pinhole and through a thin lens (whose lens points are random numbers
+//! too).
 
 mod common;
 use common::*;
+use photonmap::camera::Projection;
 use photonmap::film::Film;
 use photonmap::render::{render_progressive, Budget};
 use photonmap::scene::{Eye, Scene};
@@ -52,4 +55,21 @@ fn same_seed_same_image_on_1_2_and_3_threads() {
     assert_eq!(one, run(2, 9));
     assert_eq!(one, run(3, 9));
     assert_ne!(one, run(2, 10));
+}
+
+#[test]
+fn a_thin_lens_is_thread_independent() {
+    let mut parts = Scene::tncg15_parts(Eye::One);
+    parts.camera.projection = Projection::ThinLens { radius: 0.2, focus: 6.0 };
+    let scene = Scene::from_parts(parts);
+    let path = Settings { method: Method::Path, spp: 2, width: 40, height: 40, ..Settings::default() };
+    check_thread_independence(|seed| render_quiet(&scene, &Settings { seed, ..path }));
+    let photon =
+        Settings { photons: 10_000, caustic_photons: 10_000, spp: 1, width: 40, height: 40, ..Settings::default() };
+    check_thread_independence(|seed| {
+        render_progressive(&scene, &Settings { seed, ..photon }, Budget::passes(2), |_| {}).0
+    });
+    // The lens is used: the image differs from the pinhole's.
+    let pinhole = Scene::tncg15(Eye::One);
+    assert_ne!(render_quiet(&scene, &path), render_quiet(&pinhole, &path));
 }

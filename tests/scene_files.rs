@@ -44,6 +44,8 @@ const BROKEN: &[(&str, usize, usize, &str, &str)] = &[
     ("zero_normal.toml", 16, 10, "lights[0].normal", "must not be the zero vector"),
     ("reflectance_over_one.toml", 15, 7, "materials.hot.rho", "at most 1"),
     ("zero_width.toml", 6, 9, "camera.width", "must be in [1, 65536], got 0"),
+    ("negative_aperture.toml", 8, 19, "camera.aperture_radius", "must be >= 0 and at most 1e15, got -0.1"),
+    ("lens_without_focus.toml", 9, 19, "camera.focus_distance", "a lens needs focus_distance"),
     ("two_vertices.toml", 15, 12, "shapes[0].vertices", "needs 3 vertices, got 2"),
     ("zero_radiance.toml", 20, 8, "lights[0]", "emits no light (a colour of 0"),
     ("tiny_disk_light.toml", 20, 8, "lights[0]", "nor does any other light, so the image would be black"),
@@ -283,4 +285,26 @@ fn trace_refuses_an_image_that_cannot_fit() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && stderr.contains("65536 x 65536 image needs about"), "{stderr}");
     assert!(!out.exists());
+}
+
+/// `aperture_radius` puts a thin lens on the eye, focused at the target
+/// in the look-at form unless `focus_distance` says otherwise; 0 is the
+/// pinhole.
+#[test]
+fn a_camera_may_have_a_thin_lens() {
+    use photonmap::camera::Projection;
+    let text = |lens: &str| {
+        format!(
+            "[camera]\neye = [0, 0, 10]\ntarget = [0, 0, 4]\nup = [0, 1, 0]\nvfov = 40\nwidth = 16\nheight = 16\n{lens}\n\
+             [[lights]]\ntype = \"point\"\nposition = [0, 0, 5]\ncolor = [1, 1, 1]\n"
+        )
+    };
+    let projection = |lens: &str| parse(&text(lens), Path::new("lens.toml")).unwrap().parts.camera.projection;
+    assert_eq!(projection(""), Projection::Pinhole);
+    assert_eq!(projection("aperture_radius = 0"), Projection::Pinhole);
+    assert_eq!(projection("aperture_radius = 0.25"), Projection::ThinLens { radius: 0.25, focus: 6.0 });
+    assert_eq!(
+        projection("aperture_radius = 0.25\nfocus_distance = 2.5"),
+        Projection::ThinLens { radius: 0.25, focus: 2.5 }
+    );
 }

@@ -150,3 +150,32 @@ fn jittered_supersampling_averages_an_edge() {
     assert!(partial > 8, "{partial} pixels on the silhouette");
     assert!(film.pixels == run(3).pixels, "thread count changed the image");
 }
+
+/// Through a thin lens focused far behind the sphere, its silhouette blurs
+/// (more pixels between black and lit than through the pinhole), and the
+/// lens points, drawn from each pixel's own stream under the jittered
+/// grid, leave the image the same on 1 and 3 threads.
+#[test]
+fn a_thin_lens_blurs_the_silhouette_on_any_thread_count() {
+    let scene = |lens: &str| {
+        let text = format!(
+            "ambient = [0.1, 0.1, 0.1]\n{CAMERA}{lens}\n\
+             [materials.ball]\ntype = \"phong\"\ncolor = [1, 0.5, 0.25]\nm_a = 0.2\nm_l = 0.6\n\
+             [[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"ball\"\n{SUN}"
+        );
+        Scene::from_parts(parse(&text, Path::new("lens.toml")).unwrap().parts)
+    };
+    let (pinhole, lens) = (scene(""), scene("aperture_radius = 0.5\nfocus_distance = 40"));
+    let run = |scene: &Scene, threads| {
+        let whitted = Whitted { scene, max_depth: 0 };
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| whitted.render(32, 32, 16, 7, photonmap::progress::Mode::Quiet))
+    };
+    let partial = |film: &photonmap::film::Film| film.pixels.iter().filter(|c| c.x > 0.01 && c.x < 0.3).count();
+    let (sharp, blurred) = (run(&pinhole, 1), run(&lens, 1));
+    assert!(partial(&blurred) > 2 * partial(&sharp), "{} vs {}", partial(&blurred), partial(&sharp));
+    assert!(blurred.pixels == run(&lens, 3).pixels, "thread count changed the image");
+}

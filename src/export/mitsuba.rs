@@ -5,7 +5,7 @@
 //!
 //! | photonmap | Mitsuba 3 |
 //! |---|---|
-//! | camera (corners or look-at) | `perspective`, off-centre by `principal_point_offset_x/y`; a plane that is not a rectangle of square pixels, or a mirrored one, is refused |
+//! | camera (corners or look-at) | `perspective`, off-centre by `principal_point_offset_x/y`; a thin lens as `thinlens`, an orthographic camera as `orthographic` (module `mitsuba_sensor`); a plane that is not a rectangle of square pixels, a mirrored one, or an off-centre thin lens is refused |
 //! | triangles, meshes, tetrahedra, the room | `ply` meshes (vertex normals where the mesh is smooth, `face_normals` otherwise) |
 //! | sphere, disk | `sphere`, `disk` (by transform) |
 //! | ellipsoid | `sphere` when the transform scales evenly; else a 20,480-triangle `ply` with exact normals at its vertices (Mitsuba's sphere takes no uneven scale), and a note says so |
@@ -29,6 +29,7 @@
 //! puts the origin at it and scales the scene up, so that the offset is
 //! about 8.9e-5 of the distance to the origin.
 
+use super::mitsuba_sensor::sensor;
 use super::ply::PlyMesh;
 use crate::camera::Camera;
 use crate::light::Emitting;
@@ -73,7 +74,7 @@ impl Refusal {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Placement {
     origin: Vec3,
-    scale: f32,
+    pub(super) scale: f32,
 }
 
 impl Placement {
@@ -93,7 +94,7 @@ impl Placement {
         Placement { origin: camera.eye, scale: 1.0 }
     }
 
-    fn point(&self, p: Vec3) -> Vec3 {
+    pub(super) fn point(&self, p: Vec3) -> Vec3 {
         (p - self.origin) * self.scale
     }
 }
@@ -413,66 +414,6 @@ fn bsdf(m: &Material, id: &str) -> Result<String, String> {
     })
 }
 
-/// The camera as a Mitsuba `perspective` sensor, or why it cannot be one;
-/// placed by `placement`.
-fn sensor(camera: &Camera, placement: Placement) -> Result<String, String> {
-    let (upper_left, across, down) = camera.plane();
-    let (w, h) = (camera.width as f32, camera.height as f32);
-    let (la, ld) = (across.length(), down.length());
-    if !(la > 0.0 && ld > 0.0) || across.dot(down).abs() > 1e-4 * la * ld {
-        return Err("the image plane is not a rectangle, which a Mitsuba 3 camera cannot show".into());
-    }
-    if ((la / w) / (ld / h) - 1.0).abs() > 1e-4 {
-        return Err(format!(
-            "its pixels are not square ({:.6} x {:.6} scene units on the image plane at {}x{}); Mitsuba 3's are: \
-             give the image the plane's aspect ratio",
-            la / w,
-            ld / h,
-            camera.width,
-            camera.height
-        ));
-    }
-    let mut forward = across.cross(down).normalize();
-    let mut distance = (upper_left - camera.eye).dot(forward);
-    if distance < 0.0 {
-        forward = -forward;
-        distance = -distance;
-    }
-    if !(distance > 0.0) {
-        return Err("the eye lies in the image plane".into());
-    }
-    let up = -down / ld;
-    // Mitsuba's image runs along forward x up; a plane seen the other way
-    // round is a mirror image, which it cannot show.
-    if forward.cross(up).dot(across) <= 0.0 {
-        return Err("the image plane is seen mirrored from the eye, which a Mitsuba 3 camera cannot show".into());
-    }
-    let foot = camera.eye + distance * forward;
-    let fx = (foot - upper_left).dot(across) / (la * la);
-    let fy = (foot - upper_left).dot(down) / (ld * ld);
-    let fov = 2.0 * (0.5 * la / distance).atan().to_degrees();
-    let mut offsets = String::new();
-    if (fx - 0.5).abs() > 1e-6 {
-        let _ = writeln!(offsets, "        <float name=\"principal_point_offset_x\" value=\"{}\"/>", 0.5 - fx);
-    }
-    if (fy - 0.5).abs() > 1e-6 {
-        let _ = writeln!(offsets, "        <float name=\"principal_point_offset_y\" value=\"{}\"/>", 0.5 - fy);
-    }
-    Ok(format!(
-        "    <sensor type=\"perspective\">\n        <string name=\"fov_axis\" value=\"x\"/>\n        <float name=\"fov\" value=\"{fov}\"/>\n{offsets}\
-         \x20       <float name=\"near_clip\" value=\"{}\"/>\n        <float name=\"far_clip\" value=\"{}\"/>\n\
-         \x20       <transform name=\"to_world\"><lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>\n\
-         \x20       <sampler type=\"independent\"><integer name=\"sample_count\" value=\"$spp\"/><integer name=\"seed\" value=\"$seed\"/></sampler>\n\
-         \x20       <film type=\"hdrfilm\"><integer name=\"width\" value=\"$width\"/><integer name=\"height\" value=\"$height\"/>\
-         <string name=\"pixel_format\" value=\"rgb\"/><string name=\"component_format\" value=\"float32\"/><rfilter type=\"box\"/></film>\n    </sensor>\n",
-        1e-4 * distance * placement.scale,
-        1e7 * distance * placement.scale,
-        xyz(placement.point(camera.eye)),
-        xyz(placement.point(camera.eye) + forward),
-        xyz(up)
-    ))
-}
-
 /// The transform taking Mitsuba's unit disk (normal +z) to a disk.
 fn disk_transform(center: Vec3, normal: Vec3, radius: f32) -> String {
     let f = Frame::from_normal(normal);
@@ -480,14 +421,14 @@ fn disk_transform(center: Vec3, normal: Vec3, radius: f32) -> String {
     matrix(&m)
 }
 
-fn matrix(m: &Affine3A) -> String {
+pub(super) fn matrix(m: &Affine3A) -> String {
     let c = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis, m.translation];
     let rows: Vec<String> =
         (0..3).map(|r| (0..4).map(|k| format!("{}", c[k][r])).collect::<Vec<_>>().join(" ")).collect();
     format!("<transform name=\"to_world\"><matrix value=\"{} 0 0 0 1\"/></transform>", rows.join(" "))
 }
 
-fn xyz(v: Vec3) -> String {
+pub(super) fn xyz(v: Vec3) -> String {
     format!("{}, {}, {}", v.x, v.y, v.z)
 }
 

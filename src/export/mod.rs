@@ -3,4 +3,5 @@
 
 pub mod mitsuba;
 mod mitsuba_bsdf;
+mod mitsuba_sensor;
 mod ply;

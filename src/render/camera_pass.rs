@@ -9,9 +9,9 @@ use crate::camera::Camera;
 use crate::film::Film;
 use crate::integrator::{Context, Integrator, Part};
 use crate::progress::{Mode, Phase};
-use crate::sampling::{next_2d, sobol_owen_2d, splitmix64, stratified_2d, stream, Domain};
+use crate::sampling::{next_2d, shuffled_index, sobol_owen_2d, splitmix64, stratified_2d, stream, Domain};
 use crate::stats::Counters;
-use glam::DVec3;
+use glam::{DVec3, Vec2};
 use rayon::prelude::*;
 
 /// What a camera pass renders: the camera (at the film's resolution), the
@@ -62,6 +62,11 @@ fn pixel_scramble(seed: u64, pixel: u64, part: Part) -> u64 {
     splitmix64(splitmix64(seed ^ splitmix64(Domain::Camera as u64)) ^ splitmix64(pixel) ^ part as u64)
 }
 
+/// The scramble of a pixel's lens points, apart from its positions'.
+fn lens_scramble(scramble: u64) -> u64 {
+    splitmix64(scramble ^ 0x1E45_5A3F_1E45_5A3F)
+}
+
 /// Renders the film. The rim pixels are found once, by the probes of the
 /// first pass given an empty `rims` (with the same random streams whatever
 /// that pass is, so a render resumed at any pass finds the same), and kept: they are a property of the
@@ -78,6 +83,7 @@ pub fn camera_pass<I: Integrator>(
     let camera = &pass.camera;
     let (w, h) = (camera.width, camera.height);
     let spp = pass.spp.max(1);
+    let lens = camera.projection.has_lens();
     let mut counters = Counters::default();
     let rims: &[bool] = rims.get_or_insert_with(|| {
         if pass.edge_spp > 0 {
@@ -110,11 +116,24 @@ pub fn camera_pass<I: Integrator>(
                     let first = pass.pass.wrapping_mul(n as u64);
                     let mut sum = DVec3::ZERO;
                     for s in 0..n {
+                        let index = first.wrapping_add(s as u64) as u32;
                         let u = match pass.placement {
                             Placement::JitteredGrid => stratified_2d(s, n, next_2d(ctx.rng)),
-                            Placement::Sobol => sobol_owen_2d(first.wrapping_add(s as u64) as u32, scramble),
+                            Placement::Sobol => sobol_owen_2d(index, scramble),
                         };
-                        let ray = camera.ray(col, row, u);
+                        // A lens point per sample, from the pixel's own
+                        // sequence (stratified over the lens as the
+                        // positions are over the pixel, paired with them at
+                        // random) or its random stream.
+                        let on_lens = match pass.placement {
+                            _ if !lens => Vec2::ZERO,
+                            Placement::JitteredGrid => next_2d(ctx.rng),
+                            Placement::Sobol => {
+                                let l = lens_scramble(scramble);
+                                sobol_owen_2d(shuffled_index(index, splitmix64(l) as u32), l)
+                            }
+                        };
+                        let ray = camera.sample_ray(col, row, u, on_lens);
                         sum += integrator.radiance(ray, part, &mut ctx, thread, &mut state).as_dvec3();
                     }
                     sum += integrator.finish(&mut ctx, thread, &mut state).as_dvec3();

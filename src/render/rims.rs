@@ -9,6 +9,7 @@ use crate::integrator::{Context, Integrator, Part};
 use crate::math::max_component;
 use crate::sampling::{next_2d, stratified_2d, stream, Domain};
 use crate::stats::Counters;
+use glam::Vec2;
 use rayon::prelude::*;
 
 /// Camera rays traced per pixel to find the rim of the lights' images.
@@ -26,6 +27,7 @@ pub(super) fn light_rims<I: Integrator>(
     counters: &mut Counters,
 ) -> Vec<bool> {
     let (w, h) = (camera.width, camera.height);
+    let lens = camera.projection.has_lens();
     // Rows write into their stretch of one buffer: nothing is joined
     // serially afterwards (at 16 threads the serial stretches of this and
     // the camera pass were 3% of the pass).
@@ -43,7 +45,11 @@ pub(super) fn light_rims<I: Integrator>(
                 let mut ctx = Context { rng: &mut rng, counters: &mut row_counters, pixel };
                 *count = (0..PROBES)
                     .filter(|&s| {
-                        let ray = camera.ray(col, row, stratified_2d(s, PROBES, next_2d(ctx.rng)));
+                        let u = stratified_2d(s, PROBES, next_2d(ctx.rng));
+                        // Through the lens, a light's image blurs: its rim is
+                        // where some of the lens sees it.
+                        let on_lens = if lens { next_2d(ctx.rng) } else { Vec2::ZERO };
+                        let ray = camera.sample_ray(col, row, u, on_lens);
                         let seen = integrator.radiance(ray, Part::Emitted, &mut ctx, thread, &mut state);
                         max_component(seen + integrator.finish(&mut ctx, thread, &mut state)) > 0.0
                     })

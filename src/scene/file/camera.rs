@@ -1,9 +1,10 @@
-//! `[camera]`: the course's corner form or look-at, and the image size.
+//! `[camera]`: the course's corner form or look-at, the image size, and an
+//! optional thin lens (`aperture_radius`, `focus_distance`).
 
-use super::build::{at, At, Builder};
+use super::build::{at, At, Builder, LIMIT};
 use super::defs::V3;
 use super::SceneError;
-use crate::camera::Camera;
+use crate::camera::{Camera, Projection};
 use glam::Vec3;
 use serde::Deserialize;
 use std::ops::Range;
@@ -23,6 +24,8 @@ pub struct CameraDef {
     pub width: Spanned<i64>,
     pub height: Spanned<i64>,
     pub rays_per_pixel_edge: Option<Spanned<i64>>,
+    pub aperture_radius: Option<Spanned<f32>>,
+    pub focus_distance: Option<Spanned<f32>>,
 }
 
 impl Builder<'_> {
@@ -110,7 +113,36 @@ impl Builder<'_> {
         if let Some(problem) = camera.precision_problem() {
             return self.fail(d.eye.span(), &f("eye"), problem);
         }
+        let camera = self.lens(c, camera)?;
         Ok((camera, n))
+    }
+
+    /// A thin lens of radius `aperture_radius` focused at `focus_distance`
+    /// along the view (in the look-at form, the target's distance unless
+    /// given); a radius of 0, or none, is the pinhole.
+    fn lens(&self, c: &Spanned<CameraDef>, mut camera: Camera) -> Result<Camera, SceneError> {
+        let d = c.get_ref();
+        let radius = match &d.aperture_radius {
+            Some(r) => self.number(&at(r, "camera.aperture_radius".into()), 0.0, LIMIT, false)?,
+            None => 0.0,
+        };
+        let focus = match (&d.focus_distance, &d.target) {
+            (Some(v), _) => self.number(&at(v, "camera.focus_distance".into()), 0.0, LIMIT, true)?,
+            (None, Some(t)) => (Vec3::from_array(*t.get_ref()) - camera.eye).dot(camera.axis()),
+            (None, None) if radius > 0.0 => {
+                let span = d.aperture_radius.as_ref().map_or(c.span(), |r| r.span());
+                return self.fail(
+                    span,
+                    "camera.focus_distance",
+                    "a lens needs focus_distance (the distance along the view to the plane in focus)",
+                );
+            }
+            (None, None) => 0.0,
+        };
+        if radius > 0.0 {
+            camera.projection = Projection::ThinLens { radius, focus };
+        }
+        Ok(camera)
     }
 
     pub(super) fn need_cam<'v, T>(

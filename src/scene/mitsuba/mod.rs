@@ -20,6 +20,7 @@
 pub mod cie;
 pub mod conductors;
 mod emitters;
+mod film;
 mod materials;
 pub mod props;
 mod sensor;
@@ -160,7 +161,10 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
         return Err(sensor.fail(
             sensor.loc(),
             "far_clip",
-            format!("the scene reaches {farthest:.4e} from the eye, beyond far_clip {far}: photonmap does not clip far geometry"),
+            format!(
+                "the scene reaches {farthest:.4e} from the eye, beyond where the camera's rays end ({far}: far_clip, \
+                 less near_clip for an orthographic sensor): photonmap does not clip far geometry"
+            ),
         ));
     }
     let texturing = b.texturing();

@@ -137,7 +137,8 @@ impl<'a> Plugin<'a> {
         Ok(v)
     }
 
-    fn named_loc(&self, name: &str) -> Loc {
+    /// Where parameter `name` is written (the plugin itself where it is not).
+    pub fn named_loc(&self, name: &str) -> Loc {
         self.el.children.iter().find(|c| c.attr("name") == Some(name)).map_or(self.el.loc.clone(), |c| c.loc.clone())
     }
 

@@ -1,119 +1,71 @@
-//! `<sensor>`, its `<film>`, reconstruction filter and sampler, as the
-//! course's camera: an eye and the image plane's corners.
+//! `<sensor>`: Mitsuba 3's projective cameras as the course's camera, an
+//! eye and the image plane's corners, with the projection that turns the
+//! plane's points into rays.
 //!
-//! Mitsuba's perspective camera looks along +z of its `to_world` frame
-//! (whose x axis points to the image's left and y up, as its `lookat`
-//! builds it); its field of view is `fov` across the axis `fov_axis`
-//! names, at a plane at distance 1; a crop window and a principal point
-//! offset move the rendered window on that plane (src/sensors/perspective.cpp,
-//! src/render/sensor.cpp: `parse_fov`, `perspective_projection`).
+//! Mitsuba's cameras look along +z of their `to_world` frame (whose x axis
+//! points to the image's left and y up, as its `lookat` builds it), and all
+//! read `near_clip`, `far_clip` and `focus_distance` (default: far_clip;
+//! src/render/sensor.cpp, `ProjectiveCamera`). A crop window of the film
+//! picks part of the full film's view.
+//!
+//! - `perspective` and `thinlens`: the field of view is `fov` across the
+//!   axis `fov_axis` names (or a 35 mm `focal_length`), at a plane at
+//!   distance 1; `perspective` alone moves that window by a principal point
+//!   offset (src/sensors/perspective.cpp, src/render/sensor.cpp:
+//!   `parse_fov`, `perspective_projection`). `thinlens` adds a lens of
+//!   radius `aperture_radius` (required) focused at `focus_distance`
+//!   (src/sensors/thinlens.cpp). Neither allows scale in `to_world`.
+//! - `orthographic`: rays leave the plane z = near_clip of the camera frame
+//!   along its +z; the full film spans x in [-1, 1] and y in [-1/a, 1/a]
+//!   (a the film's width over its height) before `to_world`, whose scale
+//!   therefore sets the view's extent (src/sensors/orthographic.cpp,
+//!   `orthographic_projection` in include/mitsuba/render/sensor.h).
 
+use super::film::{film, sample_count, Film};
 use super::props::Plugin;
-use crate::camera::Camera;
-use crate::filter::Filter;
+use crate::camera::{Camera, Projection};
 use crate::scene::file::SceneError;
-use glam::{DVec3, Vec3};
+use glam::{DAffine3, DVec3, Vec3};
 
-/// The camera, the samples per pixel its sampler asks for, and the far
-/// clip distance (which the scene's builder checks lies beyond everything).
+/// What every sensor accepts beside its own parameters.
+const COMMON: &str = "to_world, near_clip, far_clip, focus_distance, film, sampler";
+
+/// The camera, the samples per pixel its sampler asks for, and how far its
+/// rays reach from its eye (which the scene's builder checks lies beyond
+/// everything: photonmap does not clip far geometry).
 pub fn camera(p: &Plugin) -> Result<(Camera, u32, f64), SceneError> {
-    if p.kind != "perspective" {
-        return Err(p.refuse(format!(
-            "the '{}' sensor is not supported (perspective is; thinlens and orthographic are not yet)",
-            p.kind
-        )));
+    if !matches!(p.kind, "perspective" | "thinlens" | "orthographic") {
+        return Err(
+            p.refuse(format!("the '{}' sensor is not supported (perspective, thinlens and orthographic are)", p.kind))
+        );
     }
-    let film = p.object("film")?.ok_or_else(|| p.refuse("the sensor needs a <film>"))?;
-    if film.kind != "hdrfilm" {
-        return Err(film.refuse(format!("the '{}' film is not supported (hdrfilm is)", film.kind)));
+    let film = film(p)?;
+    let spp = sample_count(p)?;
+    let to_world = p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
+    let near = p.float_in("near_clip", 1e-2, 0.0, 1e15)?;
+    let far = p.float_in("far_clip", 1e4, 0.0, f64::MAX)?;
+    if !(far > near) {
+        return Err(p.fail(&p.named_loc("far_clip"), "far_clip", format!("must exceed near_clip ({near}), got {far}")));
     }
-    let size = |name: &str, default: i64| -> Result<u32, SceneError> {
-        let v = film.integer(name)?.unwrap_or(default);
-        if !(1..=65536).contains(&v) {
-            return Err(film.fail(film.loc(), name, format!("must be in [1, 65536], got {v}")));
+    // Read by every projective camera in Mitsuba; only the thin lens uses it.
+    let focus = p.float("focus_distance")?.unwrap_or(far);
+    let (mut camera, reach) = match p.kind {
+        "orthographic" => {
+            p.finish(COMMON)?;
+            (orthographic(p, &film, to_world, near)?, far - near)
         }
-        Ok(v as u32)
+        _ => (perspective(p, &film, to_world, near, focus)?, far),
     };
-    // Mitsuba's hdrfilm defaults.
-    let (width, height) = (size("width", 768)?, size("height", 576)?);
-    let crop_x = film.integer("crop_offset_x")?.unwrap_or(0);
-    let crop_y = film.integer("crop_offset_y")?.unwrap_or(0);
-    let crop_w = film.integer("crop_width")?.unwrap_or(width as i64 - crop_x);
-    let crop_h = film.integer("crop_height")?.unwrap_or(height as i64 - crop_y);
-    if crop_x < 0
-        || crop_y < 0
-        || crop_w < 1
-        || crop_h < 1
-        || crop_x + crop_w > width as i64
-        || crop_y + crop_h > height as i64
-    {
-        return Err(film.refuse(format!(
-            "the crop window ({crop_x}, {crop_y}) + {crop_w}x{crop_h} does not lie in the {width}x{height} film"
-        )));
+    camera.filter = film.filter;
+    if let Some(problem) = camera.precision_problem() {
+        return Err(p.fail(p.loc(), "to_world", problem));
     }
-    // Storage formats of the written file: photonmap's EXR is always RGB
-    // in 32-bit floats, which holds what any of them would.
-    for name in ["pixel_format", "component_format", "file_format"] {
-        if let Some((v, loc)) = film.string(name)? {
-            let fine = match name {
-                "pixel_format" => matches!(v.as_str(), "rgb" | "rgba"),
-                "component_format" => matches!(v.as_str(), "float16" | "float32"),
-                _ => v == "openexr",
-            };
-            if !fine {
-                return Err(film.fail(
-                    &loc,
-                    name,
-                    format!("'{v}' is not supported (photonmap writes RGB floats to EXR)"),
-                ));
-            }
-        }
-    }
-    let filter = match film.object("rfilter")? {
-        None => Filter::Gaussian { stddev: 0.5 },
-        Some(f) => {
-            let filter = match f.kind {
-                "box" => Filter::Box,
-                "tent" => Filter::Tent { radius: f.float_in("radius", 1.0, 1e-3, 64.0)? as f32 },
-                "gaussian" => Filter::Gaussian { stddev: f.float_in("stddev", 0.5, 1e-3, 16.0)? as f32 },
-                k => {
-                    return Err(f.refuse(format!(
-                    "the '{k}' filter is not supported (box, tent and gaussian are: photonmap places samples by the \
-                         filter's distribution, which needs a filter that is nowhere negative)"
-                )))
-                }
-            };
-            f.finish("radius (tent), stddev (gaussian)")?;
-            filter
-        }
-    };
-    film.finish(
-        "width, height, crop_offset_x, crop_offset_y, crop_width, crop_height, pixel_format, component_format, \
-         file_format, rfilter",
-    )?;
-    let spp = match p.object("sampler")? {
-        None => 4,
-        Some(s) => {
-            // Every sampler gives an unbiased pixel estimate; photonmap uses
-            // its own stratified sequence and takes only the count.
-            if !matches!(s.kind, "independent" | "stratified" | "multijitter" | "orthogonal" | "ldsampler") {
-                return Err(s.refuse(format!("the '{}' sampler is not known", s.kind)));
-            }
-            let n = s.integer("sample_count")?.unwrap_or(4);
-            s.integer("seed")?;
-            s.boolean("jitter", true)?;
-            s.integer("strength")?;
-            s.finish("sample_count, seed, jitter, strength")?;
-            if !(1..=1 << 20).contains(&n) {
-                return Err(s.fail(s.loc(), "sample_count", format!("must be in [1, {}], got {n}", 1 << 20)));
-            }
-            n as u32
-        }
-    };
+    Ok((camera, spp, reach))
+}
 
-    let aspect = width as f64 / height as f64;
-    let x_fov = fov(p, aspect)?;
-    let to_world = p.transform("to_world")?.unwrap_or(glam::DAffine3::IDENTITY);
+/// `perspective` and `thinlens`: an eye (or lens) at the frame's origin.
+fn perspective(p: &Plugin, film: &Film, to_world: DAffine3, near: f64, focus: f64) -> Result<Camera, SceneError> {
+    let x_fov = fov(p, film.aspect())?;
     let m = to_world.matrix3;
     let (left, up, dir) = (m.x_axis, m.y_axis, m.z_axis);
     let scaled = [left, up, dir].iter().any(|a| (a.length() - 1.0).abs() > 1e-4)
@@ -122,35 +74,87 @@ pub fn camera(p: &Plugin) -> Result<(Camera, u32, f64), SceneError> {
         || up.dot(dir).abs() > 1e-4;
     if scaled {
         return Err(p.fail(
-            p.loc(),
+            &p.named_loc("to_world"),
             "to_world",
             "scale factors in the camera's transform are not allowed (as in Mitsuba)",
         ));
     }
-    let near = p.float_in("near_clip", 1e-2, 0.0, 1e15)?;
-    let far = p.float_in("far_clip", 1e4, 0.0, f64::MAX)?;
-    if !(far > near) {
-        return Err(p.fail(p.loc(), "far_clip", format!("must exceed near_clip ({near}), got {far}")));
-    }
-    let ppo = (p.float_or("principal_point_offset_x", 0.0)?, p.float_or("principal_point_offset_y", 0.0)?);
-    p.finish("fov, fov_axis, to_world, near_clip, far_clip, principal_point_offset_x, principal_point_offset_y, film, sampler")?;
+    let (projection, ppo) = if p.kind == "thinlens" {
+        let radius = p.float("aperture_radius")?.ok_or_else(|| {
+            p.refuse(
+                "the thinlens sensor needs aperture_radius (the lens's radius in scene units; Mitsuba has no default)",
+            )
+        })?;
+        if !(0.0..=1e15).contains(&radius) {
+            let loc = p.named_loc("aperture_radius");
+            return Err(p.fail(&loc, "aperture_radius", format!("must be in [0, 1e15], got {radius}")));
+        }
+        if !(focus > 0.0 && focus <= 1e15) {
+            let loc = p.named_loc("focus_distance");
+            return Err(p.fail(
+                &loc,
+                "focus_distance",
+                format!("must be in (0, 1e15] (its default is far_clip), got {focus}"),
+            ));
+        }
+        p.finish(&format!("aperture_radius, fov, fov_axis, focal_length, {COMMON}"))?;
+        // Mitsuba replaces a zero radius by the smallest float, a pinhole
+        // to the last bit.
+        let projection = if radius == 0.0 {
+            Projection::Pinhole
+        } else {
+            Projection::ThinLens { radius: radius as f32, focus: focus as f32 }
+        };
+        (projection, (0.0, 0.0))
+    } else {
+        let ppo = (p.float_or("principal_point_offset_x", 0.0)?, p.float_or("principal_point_offset_y", 0.0)?);
+        p.finish(&format!(
+            "fov, fov_axis, focal_length, principal_point_offset_x, principal_point_offset_y, {COMMON}"
+        ))?;
+        (Projection::Pinhole, ppo)
+    };
 
     let eye = to_world.translation;
     let tx = (0.5 * x_fov.to_radians()).tan();
-    let ty = tx / aspect;
+    let ty = tx / film.aspect();
     // A point of the full film in [0, 1]^2 (y down) on the plane at distance 1.
     let plane = |sx: f64, sy: f64| -> DVec3 { eye + dir + (1.0 - 2.0 * sx) * tx * left + (1.0 - 2.0 * sy) * ty * up };
-    let (x0, y0) = (crop_x as f64 / width as f64 + ppo.0, crop_y as f64 / height as f64 + ppo.1);
-    let (x1, y1) = (x0 + crop_w as f64 / width as f64, y0 + crop_h as f64 / height as f64);
-    let v = |d: DVec3| -> Vec3 { d.as_vec3() };
-    let (ul, ur, ll, lr) = (plane(x0, y0), plane(x1, y0), plane(x0, y1), plane(x1, y1));
-    let mut camera = Camera::from_corners(v(eye), [v(lr), v(ll), v(ul), v(ur)], crop_w as u32, crop_h as u32);
-    camera.filter = filter;
+    let ((x0, y0), (x1, y1)) = film.window();
+    let (x0, y0, x1, y1) = (x0 + ppo.0, y0 + ppo.1, x1 + ppo.0, y1 + ppo.1);
+    let mut camera = corners(eye, [plane(x0, y0), plane(x1, y0), plane(x0, y1), plane(x1, y1)], film);
     camera.near = near as f32;
-    if let Some(problem) = camera.precision_problem() {
-        return Err(p.fail(p.loc(), "to_world", problem));
+    camera.projection = projection;
+    Ok(camera)
+}
+
+/// `orthographic`: rays along the frame's +z from its plane z = `near`.
+fn orthographic(p: &Plugin, film: &Film, to_world: DAffine3, near: f64) -> Result<Camera, SceneError> {
+    let m = to_world.matrix3;
+    let volume = m.determinant().abs();
+    if !(volume > 1e-12 * m.x_axis.length() * m.y_axis.length() * m.z_axis.length()) {
+        return Err(p.fail(
+            &p.named_loc("to_world"),
+            "to_world",
+            "the transform flattens the view (its axes are not independent): an orthographic sensor needs              an extent across, up and along the view",
+        ));
     }
-    Ok((camera, spp, far))
+    let a = film.aspect();
+    let plane = |sx: f64, sy: f64| -> DVec3 {
+        to_world.transform_point3(DVec3::new(1.0 - 2.0 * sx, (1.0 - 2.0 * sy) / a, near))
+    };
+    let ((x0, y0), (x1, y1)) = film.window();
+    let centre = plane(0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let mut camera = corners(centre, [plane(x0, y0), plane(x1, y0), plane(x0, y1), plane(x1, y1)], film);
+    camera.projection = Projection::Orthographic { dir: m.z_axis.normalize().as_vec3() };
+    Ok(camera)
+}
+
+/// The camera of the crop window whose corners are upper-left, upper-right,
+/// lower-left, lower-right.
+fn corners(eye: DVec3, [ul, ur, ll, lr]: [DVec3; 4], film: &Film) -> Camera {
+    let v = |d: DVec3| -> Vec3 { d.as_vec3() };
+    let (_, _, w, h) = film.crop;
+    Camera::from_corners(v(eye), [v(lr), v(ll), v(ul), v(ur)], w, h)
 }
 
 /// The horizontal field of view in degrees, from `fov` and `fov_axis`.
