@@ -49,14 +49,51 @@ impl Emitting {
     }
 }
 
-/// A one-sided Lambertian emitter of constant radiance.
-#[derive(Clone, Copy, Debug)]
+/// A one-sided Lambertian emitter: of constant radiance, or of an image's
+/// over a triangle (Mitsuba's area emitter with a radiance texture).
+#[derive(Clone, Debug)]
 pub struct AreaLight {
     pub surface: Emitting,
+    /// The radiance; with a pattern, its mean over the surface.
     pub radiance: Color,
     /// Index of the surface's primitive in the scene (shadow rays ignore it).
     pub prim: u32,
     frame: Frame,
+    pattern: Option<Arc<AreaPattern>>,
+}
+
+/// An image's radiance over a triangle light: the texture, the triangle's
+/// texture coordinates at its corners.
+#[derive(Clone, Debug)]
+pub struct AreaPattern {
+    pub texture: Texture,
+    pub uv: [Vec2; 3],
+}
+
+impl AreaPattern {
+    /// The radiance at barycentrics `b` (of the second and third corners).
+    #[inline]
+    pub fn at(&self, b: Vec2) -> Color {
+        let uv = self.uv[0] * (1.0 - b.x - b.y) + self.uv[1] * b.x + self.uv[2] * b.y;
+        self.texture.eval(&SurfacePoint { uv, prim: 0, bary: b }).max(Color::ZERO)
+    }
+
+    /// The mean radiance over the triangle, estimated at 64 stratified
+    /// points: it only normalises (photons and light choices are weighted
+    /// by the radiance where they start over it), so it must only not be
+    /// zero where the image is not; a floor of 1e-3 of the image's largest
+    /// value sees to that.
+    fn mean(&self) -> Color {
+        let n = 8;
+        let mut sum = glam::DVec3::ZERO;
+        for j in 0..n {
+            for i in 0..n {
+                let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                sum += self.at(uniform_triangle(u)).as_dvec3();
+            }
+        }
+        (sum / (n * n) as f64).as_vec3().max(Color::splat(1e-3 * self.texture.max().max(0.0)))
+    }
 }
 
 /// A point on an area light, chosen for a shadow ray.
@@ -66,11 +103,33 @@ pub struct LightSample {
     pub normal: Vec3,
     /// pdf with respect to the light's area.
     pub pdf_area: f32,
+    /// The radiance the light leaves there.
+    pub radiance: Color,
 }
 
 impl AreaLight {
     pub fn new(surface: Emitting, radiance: Color, prim: u32) -> Self {
-        AreaLight { surface, radiance, prim, frame: Frame::from_normal(surface.normal()) }
+        AreaLight { surface, radiance, prim, frame: Frame::from_normal(surface.normal()), pattern: None }
+    }
+
+    /// The light with an image's radiance over its triangle; its
+    /// `radiance` becomes the image's mean there.
+    pub fn with_pattern(mut self, pattern: Arc<AreaPattern>) -> Self {
+        if let Emitting::Triangle(_) = self.surface {
+            self.radiance = pattern.mean();
+            self.pattern = Some(pattern);
+        }
+        self
+    }
+
+    /// The radiance leaving at barycentrics `b` of a triangle light
+    /// (towards its front).
+    #[inline]
+    pub fn radiance_at(&self, b: Vec2) -> Color {
+        match &self.pattern {
+            None => self.radiance,
+            Some(p) => p.at(b),
+        }
     }
 
     pub fn area(&self) -> f32 {
@@ -90,17 +149,17 @@ impl AreaLight {
     /// Uniform point on the surface (pdf 1 / area).
     #[inline]
     pub fn sample_point(&self, u: Vec2) -> LightSample {
-        let point = match self.surface {
+        let (point, radiance) = match self.surface {
             Emitting::Disk(disk) => {
                 let d = concentric_disk(u) * disk.radius;
-                disk.center + self.frame.s * d.x + self.frame.t * d.y
+                (disk.center + self.frame.s * d.x + self.frame.t * d.y, self.radiance)
             }
             Emitting::Triangle(t) => {
                 let b = uniform_triangle(u);
-                t.v0 * (1.0 - b.x - b.y) + t.v1 * b.x + t.v2 * b.y
+                (t.v0 * (1.0 - b.x - b.y) + t.v1 * b.x + t.v2 * b.y, self.radiance_at(b))
             }
         };
-        LightSample { point, normal: self.surface.normal(), pdf_area: 1.0 / self.area() }
+        LightSample { point, normal: self.surface.normal(), pdf_area: 1.0 / self.area(), radiance }
     }
 }
 
@@ -395,7 +454,7 @@ impl Light {
     #[inline]
     pub fn incident(&self, p: Vertex, u: Vec2) -> Option<Incident> {
         match *self {
-            Light::Area(a) => {
+            Light::Area(ref a) => {
                 let s = a.sample_point(u);
                 let to = s.point - p;
                 let dist2 = to.length_squared();
@@ -407,7 +466,7 @@ impl Light {
                 if !(cos_l > 0.0) {
                     return None;
                 }
-                let intensity = a.radiance * (cos_l / (dist2 * s.pdf_area));
+                let intensity = s.radiance * (cos_l / (dist2 * s.pdf_area));
                 Some(Incident { dir, target: Some(s.point), intensity, prim: Some(a.prim) })
             }
             Light::Point { position, intensity, falloff, dead_distance } => {
@@ -493,7 +552,7 @@ impl Light {
     /// Total emitted power per channel.
     pub fn power(&self) -> Color {
         match *self {
-            Light::Area(a) => PI * a.area() * a.radiance,
+            Light::Area(ref a) => PI * a.area() * a.radiance,
             Light::Point { intensity, .. } => 4.0 * PI * intensity,
             Light::Directional { irradiance, reach, .. } => PI * reach.1 * reach.1 * irradiance,
             Light::Spot(ref s) => s.solid_angle() * s.intensity,
@@ -516,12 +575,17 @@ impl Light {
     #[inline]
     pub fn emit(&self, u_pos: Vec2, u_dir: Vec2) -> (Ray, Option<Departure>, Color) {
         match *self {
-            Light::Area(a) => {
-                let p = a.sample_point(u_pos).point;
+            Light::Area(ref a) => {
+                let s = a.sample_point(u_pos);
                 // Unit to rounding without normalising (`Frame::to_world`):
                 // the first ray waits on it.
                 let dir = a.frame.to_world(cosine_hemisphere(u_dir));
-                (Ray::new(p, dir), Some(Departure { prim: a.prim, outward: true }), Color::ONE)
+                // An image's radiance over its mean, which the power holds.
+                let weight = match a.pattern {
+                    None => Color::ONE,
+                    Some(_) => s.radiance / a.radiance.max(Color::splat(1e-30)),
+                };
+                (Ray::new(s.point, dir), Some(Departure { prim: a.prim, outward: true }), weight)
             }
             Light::Point { position, .. } => {
                 (Ray::new(position, uniform_cone(u_dir, -1.0).normalize()), None, Color::ONE)

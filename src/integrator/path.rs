@@ -66,7 +66,7 @@ impl Integrator for PathIntegrator<'_> {
             if count_emission && wanted && !hidden {
                 // A light's own surface, or a glowing one; after a diffuse
                 // bounce the shadow rays counted it.
-                radiance += throughput * self.scene.emitted(hit.prim, ray.dir);
+                radiance += throughput * self.scene.emitted(&hit, ray.dir);
             }
             if material.is_emitter() {
                 break;

@@ -190,7 +190,7 @@ impl<'a> PhotonIntegrator<'a> {
         let through = self.scene.transmittance(departure, hit.t);
         let w = w * through;
         let material = &self.scene.material_seen(&hit, ray.dir);
-        let emitted = if seen { self.scene.emitted(hit.prim, ray.dir) } else { Color::ZERO };
+        let emitted = if seen { self.scene.emitted(&hit, ray.dir) } else { Color::ZERO };
         if material.is_emitter() {
             return through * emitted;
         }
@@ -391,7 +391,7 @@ impl<'a> PhotonIntegrator<'a> {
             weight *= self.scene.transmittance(Some(dep), y.t);
             let material = &self.scene.material_seen(&y, ray.dir);
             if from == Lobe::Glossy && specular {
-                found += weight * self.scene.emitted(y.prim, ray.dir);
+                found += weight * self.scene.emitted(&y, ray.dir);
             }
             if material.is_emitter() {
                 break;

@@ -48,7 +48,7 @@ impl Whitted<'_> {
             None => self.specular(&hit, ray, &frame, entering, material, depth, rng),
         };
         // A light's own surface, or a glowing one.
-        through * (self.scene.emitted(hit.prim, ray.dir) + shaded)
+        through * (self.scene.emitted(&hit, ray.dir) + shaded)
     }
 
     /// Mirrors and glass: every branch (Fresnel's shares for glass) traced

@@ -181,8 +181,13 @@ fn aim(
     }
     // Direction uniform in the cone of one specular object's bounding
     // sphere; pdf_w is the mixture over all cones that contain it.
+    let mut emitted = Color::ZERO;
     let (origin, departure) = match light {
-        Light::Area(a) => (a.sample_point(next_2d(rng)).point, Some(Departure { prim: a.prim, outward: true })),
+        Light::Area(a) => {
+            let s = a.sample_point(next_2d(rng));
+            emitted = s.radiance;
+            (s.point, Some(Departure { prim: a.prim, outward: true }))
+        }
         Light::Point { position, .. } => (*position, None),
         Light::Spot(s) => (s.position, None),
         Light::Projector(p) => (p.position, None),
@@ -218,7 +223,7 @@ fn aim(
             if !(cos_emit > 0.0) {
                 return None;
             }
-            a.radiance * cos_emit * a.area()
+            emitted * cos_emit * a.area()
         }
         Light::Point { intensity, .. } => *intensity,
         Light::Spot(s) => s.intensity_towards(dir.normalize()),

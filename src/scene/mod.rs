@@ -211,6 +211,8 @@ pub struct Texturing {
     pub frames: Vec<glam::Affine3A>,
     /// Per material: the normal or bump map it is seen through, if any.
     pub perturb: Vec<Option<crate::texture::Perturb>>,
+    /// Per light of the scene's parts: an image over a triangle light.
+    pub light_patterns: Vec<Option<std::sync::Arc<crate::light::AreaPattern>>>,
 }
 
 impl Texturing {
@@ -422,6 +424,8 @@ impl Scene {
                 *m = t.typical(&texturing.textures);
             }
         }
+        let mut texturing = texturing;
+        let light_patterns = std::mem::take(&mut texturing.light_patterns);
         let texturing = texturing.is_used().then(|| Box::new(texturing));
         // A one-sided material's back is a black surface of its own.
         let back_material = if one_sided.iter().any(|&b| b) {
@@ -453,7 +457,7 @@ impl Scene {
             materials.push(Material::Emitter);
         }
         let objects = prims.iter().map(|p| p.object + 1).max().unwrap_or(0);
-        for spec in &specs {
+        for (i, spec) in specs.iter().enumerate() {
             if let LightSpec::Area { surface, radiance, material } = *spec {
                 let prim = prims.len() as u32;
                 let material = material.unwrap_or(emitter);
@@ -463,7 +467,11 @@ impl Scene {
                 };
                 prims.push(Prim { shape, material, object: objects + lights.len() as u32 });
                 prim_light.push(lights.len() as u32);
-                lights.push(Light::Area(AreaLight::new(surface, radiance, prim)));
+                let light = AreaLight::new(surface, radiance, prim);
+                lights.push(Light::Area(match light_patterns.get(i) {
+                    Some(Some(p)) => light.with_pattern(p.clone()),
+                    _ => light,
+                }));
             }
         }
         let mut lo = Vec3::splat(f32::INFINITY);
@@ -688,10 +696,17 @@ impl Scene {
         &self.materials[self.prim_material[prim as usize] as usize]
     }
 
-    /// Radiance that primitive `prim` emits itself towards `-dir` (zero
-    /// unless it is the surface of an area light).
-    pub fn emitted(&self, prim: u32, dir: Vec3) -> Color {
-        self.light_of(prim).map_or(Color::ZERO, |l| l.radiance_towards(dir))
+    /// Radiance that the surface met at `hit` emits itself towards `-dir`
+    /// (zero unless it is the surface of an area light).
+    #[inline]
+    pub fn emitted(&self, hit: &Hit, dir: Vec3) -> Color {
+        self.light_of(hit.prim).map_or(Color::ZERO, |l| {
+            if dir.dot(l.surface.normal()) < 0.0 {
+                l.radiance_at(hit.bary)
+            } else {
+                Color::ZERO
+            }
+        })
     }
 
     /// The area light whose surface primitive `prim` is.

@@ -100,6 +100,7 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
         surfaces: Vec::new(),
         frames: Vec::new(),
         perturb: Vec::new(),
+        light_patterns: Vec::new(),
     };
     let mut camera: Option<(Camera, u32, f64, Plugin)> = None;
     let mut integrator_seen = false;
@@ -233,6 +234,8 @@ struct Builder<'a> {
     frames: Vec<glam::Affine3A>,
     /// Per material, the normal or bump map it is seen through.
     perturb: Vec<Option<crate::texture::Perturb>>,
+    /// Per light, the image over a triangle light.
+    light_patterns: Vec<Option<std::sync::Arc<crate::light::AreaPattern>>>,
 }
 
 impl Builder<'_> {

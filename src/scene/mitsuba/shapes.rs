@@ -11,7 +11,7 @@
 //! computes them, unless `face_normals` is set. A transform that mirrors
 //! reverses the winding, so that the front stays where the normals point.
 
-use super::props::Plugin;
+use super::props::{Plugin, Value};
 use super::spectrum::Use;
 use super::Builder;
 use crate::light::Emitting;
@@ -74,10 +74,22 @@ impl Builder<'_> {
         let bsdf = p.object("bsdf")?;
         let material = self.material(bsdf.as_ref())?;
         let emitter = p.object("emitter")?;
+        let mut image = None;
         let radiance = match &emitter {
             None => None,
             Some(e) if e.kind == "area" => {
-                let r = e.color("radiance", Use::Emission)?.unwrap_or(Color::ONE);
+                let r = match e.value("radiance", Use::Emission)? {
+                    None => Color::ONE,
+                    Some(Value::Color(c)) => c,
+                    Some(Value::Texture(t)) => {
+                        let texture = self.emitter_texture(&t)?;
+                        if texture.min() < 0.0 {
+                            return Err(t.refuse("an emitted radiance must not be negative"));
+                        }
+                        image = Some(texture);
+                        Color::ONE
+                    }
+                };
                 e.finish("radiance")?;
                 if r.min_element() < 0.0 {
                     return Err(e.fail(e.loc(), "radiance", "must not be negative"));
@@ -228,6 +240,9 @@ impl Builder<'_> {
                     self.surface(self.prims.len(), uv.unwrap_or(SurfaceUv::Barycentric));
                     self.prims.push(Prim { shape, material, object })
                 }
+                (Some(_), Shape::Disk(_)) if image.is_some() => {
+                    return Err(p.refuse("an emitting disk with a radiance texture is not supported yet (meshes and rectangles are)"))
+                }
                 (Some(radiance), Shape::Disk(d)) => {
                     self.lights.push(LightSpec::Area { surface: Emitting::Disk(d), radiance, material: Some(material) })
                 }
@@ -238,7 +253,7 @@ impl Builder<'_> {
                     )))
                 }
             },
-            Mesh::Tris(t) => self.push_triangles(t, &to_world, flip, material, object, radiance),
+            Mesh::Tris(t) => self.push_triangles(t, &to_world, flip, material, object, radiance, image),
         }
         Ok(())
     }
@@ -251,6 +266,7 @@ impl Builder<'_> {
         material: u32,
         object: u32,
         radiance: Option<Color>,
+        image: Option<std::sync::Arc<crate::texture::Texture>>,
     ) {
         let normal_map = to_world.matrix3.inverse().transpose();
         // A mirroring transform and flip_normals each turn the surface over.
@@ -278,6 +294,11 @@ impl Builder<'_> {
                 continue;
             }
             if let Some(radiance) = radiance {
+                if let Some(texture) = &image {
+                    let pattern = crate::light::AreaPattern { texture: (**texture).clone(), uv };
+                    self.light_patterns.resize(self.lights.len(), None);
+                    self.light_patterns.push(Some(std::sync::Arc::new(pattern)));
+                }
                 self.lights.push(LightSpec::Area {
                     surface: Emitting::Triangle(t),
                     radiance,

@@ -162,6 +162,7 @@ impl Builder<'_> {
             surfaces: std::mem::take(&mut self.surfaces),
             frames: std::mem::take(&mut self.frames),
             perturb: std::mem::take(&mut self.perturb),
+            light_patterns: std::mem::take(&mut self.light_patterns),
         }
     }
 }
