@@ -78,7 +78,7 @@ fn sky_map() -> Arc<EnvMap> {
         .map(|i| {
             let (x, y) = (i % w, i / w);
             if (20..23).contains(&x) && (4..6).contains(&y) {
-                Color::new(60.0, 50.0, 40.0)
+                Color::new(20.0, 16.0, 12.0)
             } else {
                 Color::new(0.2, 0.3, 0.5) * (1.0 + (y as f32) / h as f32)
             }
@@ -88,8 +88,8 @@ fn sky_map() -> Arc<EnvMap> {
 }
 
 /// Open to the sky: a rough metal sphere (GGX 0.08) and a rough plastic
-/// one (GGX 0.2) on a rough plastic floor (Beckmann 0.3), under a small
-/// disk light, a constant sky and an environment map.
+/// one (GGX 0.2) on a rough plastic floor (Beckmann 0.3), under a disk
+/// light, a constant sky and an environment map.
 fn open_scene(paths: PathLimits) -> Scene {
     let materials = vec![
         Material::rough_conductor(
@@ -105,10 +105,18 @@ fn open_scene(paths: PathLimits) -> Scene {
     ];
     let mut prims = vec![
         Prim { shape: Shape::Sphere(Sphere { center: Vec3::new(0.0, 0.6, 0.0), radius: 0.5 }), material: 0, object: 0 },
-        Prim { shape: Shape::Sphere(Sphere { center: Vec3::new(0.0, -0.6, 0.0), radius: 0.5 }), material: 1, object: 1 },
+        Prim {
+            shape: Shape::Sphere(Sphere { center: Vec3::new(0.0, -0.6, 0.0), radius: 0.5 }),
+            material: 1,
+            object: 1,
+        },
     ];
-    let (a, b, c, d) =
-        (Vec3::new(-3.0, -3.0, -0.5), Vec3::new(3.0, -3.0, -0.5), Vec3::new(3.0, 3.0, -0.5), Vec3::new(-3.0, 3.0, -0.5));
+    let (a, b, c, d) = (
+        Vec3::new(-3.0, -3.0, -0.5),
+        Vec3::new(3.0, -3.0, -0.5),
+        Vec3::new(3.0, 3.0, -0.5),
+        Vec3::new(-3.0, 3.0, -0.5),
+    );
     for t in [Triangle::new(a, b, c), Triangle::new(a, c, d)] {
         prims.push(Prim { shape: Shape::Triangle(t), material: 2, object: 2 });
     }
@@ -123,13 +131,15 @@ fn open_scene(paths: PathLimits) -> Scene {
         16,
         16,
     );
-    let light = Disk { center: Vec3::new(-1.0, 0.0, 2.5), normal: Vec3::new(0.3, 0.0, -1.0).normalize(), radius: 0.3 };
+    // Above and behind the camera, out of its view, in the spheres'
+    // highlights.
+    let light = Disk { center: Vec3::new(-2.0, 0.0, 2.0), normal: Vec3::new(0.6, 0.0, -0.8), radius: 0.8 };
     Scene::from_parts(SceneParts {
         prims,
         shading_normals: Vec::new(),
         materials,
         lights: vec![
-            LightSpec::Area { surface: Emitting::Disk(light), radiance: Color::splat(40.0), material: None },
+            LightSpec::Area { surface: Emitting::Disk(light), radiance: Color::splat(30.0), material: None },
             LightSpec::Constant { radiance: Color::splat(0.3) },
             LightSpec::Envmap(sky_map()),
         ],
@@ -182,9 +192,8 @@ fn blocks<I: Integrator>(integrator: &I, scene: &Scene, size: u32, passes: u32, 
 }
 
 /// Every block's MIS mean within its error of the light-sampling mean
-/// (z below 4.5: a family-wise level of ~1e-4 over the 16 blocks); and the
-/// total variance, which MIS must not raise by much and should lower.
-fn assert_agree(name: &str, mis: &Blocks, plain: &Blocks) -> f64 {
+/// (z below 4.5: a family-wise level of ~1e-4 over the 16 blocks).
+fn assert_agree(name: &str, mis: &Blocks, plain: &Blocks) {
     let mut worst: f64 = 0.0;
     for k in 0..mis.mean.len() {
         let (a, b) = (mis.mean[k], plain.mean[k]);
@@ -194,50 +203,81 @@ fn assert_agree(name: &str, mis: &Blocks, plain: &Blocks) -> f64 {
         worst = worst.max(z.abs());
         assert!(z.abs() < 4.5, "{name} block {k}: MIS {a:.5} against shadow rays alone {b:.5} (z {z:.2})");
     }
-    let ratio = mis.var.iter().sum::<f64>() / plain.var.iter().sum::<f64>();
-    eprintln!("{name}: worst |z| {worst:.2}, variance with MIS / without {ratio:.3}");
-    ratio
+    let total = |b: &Blocks| b.mean.iter().sum::<f64>();
+    eprintln!(
+        "{name}: worst |z| {worst:.2}, block means summed {:.5} with MIS, {:.5} without",
+        total(mis),
+        total(plain)
+    );
 }
 
-fn path_blocks(scene: &Scene, mis: bool, passes: u32, seed: u64) -> Blocks {
-    let integrator = PathIntegrator { scene, shadow_rays: 1, skip: true, mis };
+/// Shadow rays alone are noisy where a narrow lobe sees a large light:
+/// they take many more per vertex, so that the comparison's error is not
+/// theirs alone.
+fn shadow_rays(mis: bool) -> u32 {
+    if mis {
+        2
+    } else {
+        32
+    }
+}
+
+fn path_blocks(scene: &Scene, mis: bool, rays: u32, passes: u32, seed: u64) -> Blocks {
+    let integrator = PathIntegrator { scene, shadow_rays: rays, skip: true, mis };
     blocks(&integrator, scene, 16, passes, seed)
 }
 
-fn photon_blocks(scene: &Scene, passes: u32) -> (Blocks, Blocks) {
-    let settings = Settings { photons: 40_000, caustic_photons: 40_000, gather_rays: 4, shadow_rays: 1, ..Settings::default() };
+/// Photon mapping with and without MIS, the same photon maps for both.
+fn photon_blocks(scene: &Scene, rays: [u32; 2], passes: u32) -> (Blocks, Blocks) {
+    let settings = Settings { photons: 40_000, caustic_photons: 40_000, gather_rays: 0, ..Settings::default() };
     let est = Estimates::progressive(scene, &settings, 0);
     let maps = photon_pass(scene, &settings, 0, est, Mode::Quiet, &mut Stats::default());
     let mut integrator = photon_integrator(scene, &settings, &maps, est);
+    integrator.settings.shadow_rays = rays[0];
     let mis = blocks(&integrator, scene, 16, passes, 21);
     integrator.settings.mis = false;
+    integrator.settings.shadow_rays = rays[1];
     let plain = blocks(&integrator, scene, 16, passes, 22);
     (mis, plain)
 }
 
-#[test]
-fn path_tracing_with_mis_agrees_in_the_mean() {
-    for (name, scene) in [
+fn scenes() -> [(&'static str, Scene); 3] {
+    [
         ("rough room", rough_room(PathLimits::default())),
         ("open scene", open_scene(PathLimits::default())),
         ("open scene, max_depth 2", open_scene(PathLimits { max_depth: Some(2), hide_emitters: false })),
-    ] {
-        let ratio = assert_agree(name, &path_blocks(&scene, true, 400, 1), &path_blocks(&scene, false, 400, 2));
-        assert!(ratio < 1.1, "{name}: MIS raised the variance by {ratio}");
+    ]
+}
+
+#[test]
+fn path_tracing_with_mis_agrees_in_the_mean() {
+    for (name, scene) in scenes() {
+        let (mis, plain) = (shadow_rays(true), shadow_rays(false));
+        assert_agree(name, &path_blocks(&scene, true, mis, 1000, 1), &path_blocks(&scene, false, plain, 1000, 2));
     }
 }
 
 #[test]
 fn photon_mapping_with_mis_agrees_in_the_mean() {
-    for (name, scene) in [
-        ("rough room", rough_room(PathLimits::default())),
-        ("open scene", open_scene(PathLimits::default())),
-        ("open scene, max_depth 2", open_scene(PathLimits { max_depth: Some(2), hide_emitters: false })),
-    ] {
-        let (mis, plain) = photon_blocks(&scene, 200);
-        let ratio = assert_agree(&format!("{name} (photon mapping)"), &mis, &plain);
-        assert!(ratio < 1.1, "{name}: MIS raised the variance by {ratio}");
+    for (name, scene) in scenes() {
+        let (mis, plain) = photon_blocks(&scene, [shadow_rays(true), shadow_rays(false)], 1000);
+        assert_agree(&format!("{name} (photon mapping)"), &mis, &plain);
     }
+}
+
+/// With as many shadow rays, MIS is far less noisy on the open scene,
+/// whose highlights of the sky and the small light are what it is for
+/// (measured: the path tracer's variance x 0.4, photon mapping's, where
+/// final gathering's noise stays, x 0.4).
+#[test]
+fn mis_quiets_glossy_highlights() {
+    let scene = open_scene(PathLimits::default());
+    let ratio = |mis: &Blocks, plain: &Blocks| mis.var.iter().sum::<f64>() / plain.var.iter().sum::<f64>();
+    let path = ratio(&path_blocks(&scene, true, 2, 200, 3), &path_blocks(&scene, false, 2, 200, 4));
+    let (mis, plain) = photon_blocks(&scene, [2, 2], 200);
+    let photon = ratio(&mis, &plain);
+    eprintln!("variance with MIS / without: path tracing {path:.3}, photon mapping {photon:.3}");
+    assert!(path < 0.6 && photon < 0.7, "path tracing {path}, photon mapping {photon}");
 }
 
 /// Shading points about a light: in front, oblique, beside it.
@@ -245,7 +285,7 @@ fn points() -> [(Vec3, Vec3); 3] {
     [
         (Vec3::new(0.0, 0.0, 0.0), Vec3::Z),
         (Vec3::new(0.7, -0.4, 0.2), Vec3::new(0.3, 0.1, 1.0).normalize()),
-        (Vec3::new(-1.5, 0.3, 0.8), Vec3::new(-0.6, 0.0, 0.8).normalize()),
+        (Vec3::new(-1.5, 0.3, 0.3), Vec3::new(-0.6, 0.0, 0.8).normalize()),
     ]
 }
 
@@ -255,9 +295,9 @@ fn points() -> [(Vec3, Vec3); 3] {
 #[test]
 fn lights_sample_their_own_density() {
     let disk = Disk { center: Vec3::new(0.2, 0.1, 1.2), normal: Vec3::new(0.2, -0.1, -1.0).normalize(), radius: 0.9 };
+    let triangle = Triangle::new(Vec3::new(-1.0, -1.0, 1.0), Vec3::new(1.5, -0.5, 1.6), Vec3::new(-0.5, 1.5, 0.9));
     let triangle =
-        Triangle::new(Vec3::new(-1.0, -1.0, 1.0), Vec3::new(1.5, -0.5, 1.6), Vec3::new(-0.5, 1.5, 0.9));
-    let triangle = if triangle.normal.z > 0.0 { Triangle::new(triangle.v0, triangle.v2, triangle.v1) } else { triangle };
+        if triangle.normal.z > 0.0 { Triangle::new(triangle.v0, triangle.v2, triangle.v1) } else { triangle };
     let lights = [
         ("disk", Light::Area(AreaLight::new(Emitting::Disk(disk), Color::ONE, 0))),
         ("triangle", Light::Area(AreaLight::new(Emitting::Triangle(triangle), Color::ONE, 0))),
@@ -281,6 +321,8 @@ fn lights_sample_their_own_density() {
             if !o.passed() {
                 failed.push(format!("{name} at {p}: p {}", o.p_value));
             }
+            // Every point sees the light: the test bins something.
+            assert!(o.pdf_mass > 0.01, "{name} at {p}: pdf mass {}", o.pdf_mass);
             // A sample's own density is the one MIS reads, found again
             // from its direction alone (but where rounding moves the
             // direction across a light's rim or an environment map's

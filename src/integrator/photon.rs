@@ -14,7 +14,10 @@
 //! |                          | the global map's irradiance precomputed near y |
 //!
 //! Gather rays that reach a light (directly or through mirrors and glass)
-//! add nothing: those paths belong to the first two rows.
+//! add nothing: those paths belong to the first two rows. At a glossy lobe
+//! the direct light's shadow rays share it with the lobe's own sample by
+//! multiple importance sampling ([`super::mis`]): a light that sample meets
+//! straight away counts with its weight.
 
 use super::aim::{Aim, AimTargets};
 use super::mis::BsdfSample;
@@ -434,9 +437,13 @@ impl<'a> PhotonIntegrator<'a> {
     /// met, its diffuse lobe's light is read from the irradiance cache (the
     /// read left for later, with weight `w` and the path's), and its glossy
     /// lobe takes its direct light by shadow rays. Light met after mirrors
-    /// or glass counts only where the last non-specular vertex was glossy:
-    /// a diffuse one's is the caustic map's, and light met straight from a
-    /// non-specular vertex is its direct estimate's (notes/method.md).
+    /// or glass (a light's surface, or light from everywhere where the ray
+    /// leaves the scene) counts only where the last non-specular vertex was
+    /// glossy: a diffuse one's is the caustic map's. Light met straight
+    /// from a non-specular vertex is its direct estimate's, but where that
+    /// vertex shared its direct light with the lobe's sample (`shared`:
+    /// MIS at glossy lobes, [`super::mis`]): then it counts with the
+    /// sample's weight (notes/method.md).
     ///
     /// A glossy lobe that carries caustics ([`crate::material::Glossy`])
     /// stands for a specular one while the path is still a diffuse
@@ -532,7 +539,12 @@ impl<'a> PhotonIntegrator<'a> {
                 }
                 if let Some(g) = mis {
                     let pdf = (1.0 - p_specular) * g.pdf(wo, wi, entering);
-                    shared = Some(BsdfSample { point: y.point, normal: frame.n, pdf, shadow_rays: self.settings.shadow_rays });
+                    shared = Some(BsdfSample {
+                        point: y.point,
+                        normal: frame.n,
+                        pdf,
+                        shadow_rays: self.settings.shadow_rays,
+                    });
                 }
                 frame.to_world(wi).normalize()
             };
