@@ -77,7 +77,10 @@ pub struct MisBsdf {
 /// weighted by the power heuristic against the BSDF's density
 /// ([`super::mis`]), the `alone` part in full. Delta lights, which no
 /// sampled direction meets, keep the weight one. One sample at a time.
+/// Never inlined: the loops that call it at every vertex (final
+/// gathering's) stay as small as they were for scenes without glossy lobes.
 #[allow(clippy::too_many_arguments)]
+#[inline(never)]
 pub fn direct_light_mis(
     scene: &Scene,
     hit: &Hit,

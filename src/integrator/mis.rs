@@ -64,6 +64,7 @@ impl BsdfSample {
 
     /// Radiance leaving the area light whose surface the sample met at
     /// `hit` (travelling along `dir`), weighted; zero for any other surface.
+    #[inline(never)]
     pub fn emitted(&self, scene: &Scene, hit: &Hit, dir: Vec3) -> Color {
         let Some(area) = scene.light_of(hit.prim) else { return Color::ZERO };
         let le = area.radiance_towards(dir);
@@ -75,6 +76,7 @@ impl BsdfSample {
 
     /// Light from everywhere arriving along `dir` (the sample met
     /// nothing), each light at infinity weighted by its own density.
+    #[inline(never)]
     pub fn from_infinity(&self, lights: &[Light], dir: Vec3) -> Color {
         let mut sum = Color::ZERO;
         for light in lights {
