@@ -6,7 +6,9 @@
 //! Every light answers two questions with the same geometry, so that shadow
 //! rays and photons agree on its power: the light arriving at a point from a
 //! sample of the light ([`Light::incident`]), and where a photon starts
-//! ([`Light::emit`]).
+//! ([`Light::emit`]). Each also answers the density with which its shadow
+//! rays choose a direction ([`Light::pdf_around`]), which multiple
+//! importance sampling at glossy surfaces weighs them by.
 
 use crate::envmap::EnvMap;
 use crate::math::{Color, Frame, Ray, Vertex};
