@@ -6,12 +6,14 @@
 //! Every light answers two questions with the same geometry, so that shadow
 //! rays and photons agree on its power: the light arriving at a point from a
 //! sample of the light ([`Light::incident`]), and where a photon starts
-//! ([`Light::emit`]).
+//! ([`Light::emit`]). Each also answers the density with which its shadow
+//! rays choose a direction ([`Light::pdf_around`]), which multiple
+//! importance sampling at glossy surfaces weighs them by.
 
 use crate::envmap::EnvMap;
 use crate::math::{Color, Frame, Ray, Vertex};
 use crate::sampling::{concentric_disk, cosine_hemisphere, uniform_cone, uniform_triangle};
-use crate::shape::{Departure, Disk, Triangle};
+use crate::shape::{Departure, Disk, RayShear, Triangle};
 use crate::texture::{SurfacePoint, Texture};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -45,6 +47,14 @@ impl Emitting {
         match self {
             Emitting::Disk(d) => d.center,
             Emitting::Triangle(t) => t.v0,
+        }
+    }
+
+    /// Where a ray meets the surface (either side), if it does.
+    fn distance(&self, ray: &Ray) -> Option<f32> {
+        match self {
+            Emitting::Disk(d) => d.distance(ray, f32::INFINITY),
+            Emitting::Triangle(t) => t.distance(ray, &RayShear::new(ray), f32::INFINITY).map(|(t, _, _)| t),
         }
     }
 }
@@ -144,6 +154,20 @@ impl AreaLight {
         } else {
             Color::ZERO
         }
+    }
+
+    /// The density per solid angle, seen from `p`, with which
+    /// [`Light::incident`] draws the direction towards the light's point
+    /// `y`: |y - p|² / (cos_l area), zero where `p` sees the back.
+    #[inline]
+    pub fn pdf_at(&self, p: Vertex, y: Vertex) -> f32 {
+        let to = y - p;
+        let dist2 = to.length_squared();
+        let cos_l = -to.dot(self.surface.normal()) / dist2.sqrt();
+        if !(cos_l > 0.0 && dist2 > 0.0) {
+            return 0.0;
+        }
+        dist2 / (cos_l * self.area())
     }
 
     /// Uniform point on the surface (pdf 1 / area).
@@ -546,6 +570,42 @@ impl Light {
                 Some(Incident { dir, target: None, intensity: radiance * (PI / local.z), prim: None })
             }
             _ => self.incident(p, u),
+        }
+    }
+
+    /// The density per solid angle with which [`Self::incident_around`]
+    /// (at `p`, facing `n`) returns unit direction `dir`: an area light's
+    /// where `dir` meets its front, light from everywhere's by its own
+    /// sampling; zero where it never returns `dir`, and for the delta
+    /// lights, whose directions have no density (no other sampling finds
+    /// them).
+    pub fn pdf_around(&self, p: Vertex, n: Vec3, dir: Vec3) -> f32 {
+        match *self {
+            Light::Area(ref a) => a.surface.distance(&Ray::new(p, dir)).map_or(0.0, |t| a.pdf_at(p, p + t * dir)),
+            Light::Constant { .. } => dir.dot(n).max(0.0) / PI,
+            Light::Envmap { ref map, .. } => map.pdf(dir),
+            _ => 0.0,
+        }
+    }
+
+    /// [`Self::pdf_around`] of a sample `incident_around` returned.
+    #[inline]
+    pub fn pdf_of(&self, p: Vertex, n: Vec3, inc: &Incident) -> f32 {
+        match (self, inc.target) {
+            (Light::Area(a), Some(y)) => a.pdf_at(p, y),
+            _ => self.pdf_around(p, n, inc.dir),
+        }
+    }
+
+    /// Radiance arriving from unit direction `towards` from light at
+    /// infinity (constant sky, environment map); zero for every other
+    /// light.
+    #[inline]
+    pub fn radiance_from_infinity(&self, towards: Vec3) -> Color {
+        match *self {
+            Light::Constant { radiance, .. } => radiance,
+            Light::Envmap { ref map, .. } => map.eval(towards),
+            _ => Color::ZERO,
         }
     }
 

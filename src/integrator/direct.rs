@@ -1,5 +1,6 @@
 //! Direct light: shadow rays to samples of the lights.
 
+use super::mis::power_heuristic;
 use super::Context;
 use crate::light::{Incident, Light};
 use crate::math::{Color, Ray};
@@ -52,6 +53,58 @@ pub fn direct_light(
                 if unshadowed(scene, hit, &inc, ctx) {
                     sum += brdf(inc.dir) * inc.intensity * cos_x.abs();
                 }
+            }
+        }
+        sum
+    })
+}
+
+/// What a vertex's BSDF answers for a direction towards a light, for
+/// [`direct_light_mis`].
+#[derive(Clone, Copy, Debug)]
+pub struct MisBsdf {
+    /// The part of the BSDF only shadow rays estimate (a plastic's diffuse
+    /// base, where the continuation samples the coat alone).
+    pub alone: Color,
+    /// The part also estimated by the continuation's sample.
+    pub shared: Color,
+    /// The density with which the continuation draws the direction.
+    pub pdf: f32,
+}
+
+/// [`direct_light`] at a vertex whose continuation is also sampled for the
+/// light it meets (notes/method.md, §7): each shadow ray's `shared` part
+/// weighted by the power heuristic against the BSDF's density
+/// ([`super::mis`]), the `alone` part in full. Delta lights, which no
+/// sampled direction meets, keep the weight one. One sample at a time.
+/// Never inlined: the loops that call it at every vertex (final
+/// gathering's) stay as small as they were for scenes without glossy lobes.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+pub fn direct_light_mis(
+    scene: &Scene,
+    hit: &Hit,
+    n: Vec3,
+    bsdf: impl Fn(Vec3) -> MisBsdf,
+    count: u32,
+    skip: bool,
+    both_sides: bool,
+    ctx: &mut Context,
+) -> Color {
+    each_light(scene, hit, count, skip, ctx, |light, count, ctx| {
+        let mut sum = Color::ZERO;
+        for s in 0..count {
+            let u = stratified_2d(s, count, next_2d(ctx.rng));
+            let Some(inc) = light.incident_around(hit.point, n, u) else { continue };
+            let cos_x = n.dot(inc.dir);
+            if facing(cos_x, both_sides) && reaches(hit, n, inc.dir, cos_x > 0.0) && unshadowed(scene, hit, &inc, ctx) {
+                let f = bsdf(inc.dir);
+                let w = if light.is_delta() {
+                    1.0
+                } else {
+                    power_heuristic(count as f32, light.pdf_of(hit.point, n, &inc), 1.0, f.pdf)
+                };
+                sum += (f.alone + f.shared * w) * inc.intensity * cos_x.abs();
             }
         }
         sum

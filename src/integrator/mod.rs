@@ -12,12 +12,13 @@
 
 mod aim;
 mod direct;
+pub mod mis;
 pub mod path;
 pub mod photon;
 pub mod unseen;
 pub mod whitted;
 
-pub use direct::{direct_irradiance, direct_light, direct_light_one_at_a_time};
+pub use direct::{direct_irradiance, direct_light, direct_light_mis, direct_light_one_at_a_time, MisBsdf};
 
 use crate::math::{Color, Ray};
 use crate::sampling::Rng;

@@ -3,12 +3,17 @@
 //!
 //! At each diffuse vertex, direct light is estimated by a shadow ray to the
 //! lights; a path that then reaches a light after a diffuse bounce adds
-//! nothing (that light was already counted). Emission is counted on camera
-//! rays and after mirror or glass bounces, whose delta lobes a shadow ray
-//! cannot sample. Mirror and glass are sampled (Fresnel chooses the branch);
-//! Russian roulette on the path's throughput ends long paths without bias.
+//! nothing (that light was already counted). At a vertex with a glossy
+//! lobe, the shadow rays and the continuation's direction share the light
+//! by multiple importance sampling ([`super::mis`]): the light the
+//! continuation meets next is added with its weight. Emission is counted in
+//! full on camera rays and after mirror or glass bounces, whose delta lobes
+//! a shadow ray cannot sample. Mirror and glass are sampled (Fresnel
+//! chooses the branch); Russian roulette on the path's throughput ends long
+//! paths without bias.
 
-use super::{direct_light, Context, Integrator, Part};
+use super::mis::BsdfSample;
+use super::{direct_light, direct_light_mis, Context, Integrator, MisBsdf, Part};
 use crate::material::{Lobe, Scatter, Transport};
 use crate::math::{max_component, Color, Ray};
 use crate::scene::Scene;
@@ -25,6 +30,10 @@ pub struct PathIntegrator<'a> {
     pub shadow_rays: u32,
     /// Skip lights that face away from the shaded point.
     pub skip: bool,
+    /// Multiple importance sampling of direct light at vertices with a
+    /// glossy lobe (off: shadow rays alone, the estimate it must agree
+    /// with in the mean).
+    pub mis: bool,
 }
 
 impl Integrator for PathIntegrator<'_> {
@@ -39,6 +48,9 @@ impl Integrator for PathIntegrator<'_> {
         let mut count_emission = true;
         // Whether every vertex so far was specular (the path is E S* so far).
         let mut specular_chain = true;
+        // Where the last vertex shared its direct light with the direction
+        // drawn from it: the light met now is added with its MIS weight.
+        let mut shared: Option<BsdfSample> = None;
         // This hit is the path's vertex depth + 1 after the eye; a scene
         // may limit how many there are (Mitsuba's max_depth).
         let limits = self.scene.paths;
@@ -58,6 +70,8 @@ impl Integrator for PathIntegrator<'_> {
                 // Light from everywhere, where shadow rays did not count it.
                 if count_emission && wanted && !hidden {
                     radiance += throughput * self.scene.background(ray.dir);
+                } else if let Some(b) = shared.filter(|_| wanted) {
+                    radiance += throughput * b.from_infinity(&self.scene.lights, ray.dir);
                 }
                 break;
             };
@@ -67,6 +81,8 @@ impl Integrator for PathIntegrator<'_> {
                 // A light's own surface, or a glowing one; after a diffuse
                 // bounce the shadow rays counted it.
                 radiance += throughput * self.scene.emitted(&hit, ray.dir);
+            } else if let Some(b) = shared.filter(|_| wanted) {
+                radiance += throughput * b.emitted(self.scene, &hit, ray.dir);
             }
             if material.is_emitter() {
                 break;
@@ -81,13 +97,30 @@ impl Integrator for PathIntegrator<'_> {
                 };
                 Scatter { wi: b.wi, weight: b.scale, lobe: Lobe::Specular }
             } else {
-                if material.has_smooth_lobes() && within(depth + 2) {
-                    let brdf = |w| material.eval(wo, frame.to_local(w), entering, Transport::Radiance);
-                    let both = material.transmits();
-                    let direct = direct_light(self.scene, &hit, n, brdf, self.shadow_rays, self.skip, both, ctx);
+                let lit = material.has_smooth_lobes() && within(depth + 2);
+                let mis = lit && self.mis && material.glossy().is_some();
+                if lit {
+                    let (count, skip, both) = (self.shadow_rays, self.skip, material.transmits());
+                    let direct = if mis {
+                        let bsdf = |w| {
+                            let wi = frame.to_local(w);
+                            let shared = material.eval(wo, wi, entering, Transport::Radiance);
+                            MisBsdf { alone: Color::ZERO, shared, pdf: material.pdf(wo, wi, entering) }
+                        };
+                        direct_light_mis(self.scene, &hit, n, bsdf, count, skip, both, ctx)
+                    } else {
+                        let brdf = |w| material.eval(wo, frame.to_local(w), entering, Transport::Radiance);
+                        direct_light(self.scene, &hit, n, brdf, count, skip, both, ctx)
+                    };
                     radiance += throughput * ctx.checked(direct, "path direct");
                 }
                 let Some(s) = material.sample(wo, entering, Transport::Radiance, ctx.rng) else { break };
+                shared = (mis && s.lobe != Lobe::Specular).then(|| BsdfSample {
+                    point: hit.point,
+                    normal: n,
+                    pdf: material.pdf(wo, s.wi, entering),
+                    shadow_rays: self.shadow_rays,
+                });
                 s
             };
             let dir = frame.to_world(scatter.wi).normalize();

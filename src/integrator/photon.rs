@@ -14,11 +14,15 @@
 //! |                          | the global map's irradiance precomputed near y |
 //!
 //! Gather rays that reach a light (directly or through mirrors and glass)
-//! add nothing: those paths belong to the first two rows.
+//! add nothing: those paths belong to the first two rows. At a glossy lobe
+//! the direct light's shadow rays share it with the lobe's own sample by
+//! multiple importance sampling ([`super::mis`]): a light that sample meets
+//! straight away counts with its weight.
 
 use super::aim::{Aim, AimTargets};
-use super::{direct_light, Context, Integrator, Part};
-use crate::material::{Branch, Branches, Lobe, Material, Transport};
+use super::mis::BsdfSample;
+use super::{direct_light, direct_light_mis, Context, Integrator, MisBsdf, Part};
+use crate::material::{Branch, Branches, Glossy, Lobe, Material, Transport};
 use crate::math::{Color, Frame, Ray};
 use crate::photon::irradiance_cache::{CellRange, IrradianceCache};
 use crate::photon::map::{ConeEstimate, PhotonMap, Scratch};
@@ -69,6 +73,10 @@ pub struct PhotonEstimator {
     /// samples ([`PendingRead`]); off: each read is made at once (the plain
     /// version, which it must equal to rounding).
     pub defer_reads: bool,
+    /// Multiple importance sampling of direct light at glossy lobes with
+    /// the lobe's own samples ([`super::mis`]; off: shadow rays alone, the
+    /// estimate it must agree with in the mean).
+    pub mis: bool,
 }
 
 /// A read of precomputed irradiance that a camera sample leaves for later:
@@ -252,16 +260,37 @@ impl<'a> PhotonIntegrator<'a> {
         sh: &mut Shade<'_, '_, 'a>,
     ) -> Color {
         let n = frame.n;
-        let brdf = |w: glam::Vec3| material.eval(wo, frame.to_local(w), entering, Transport::Radiance);
         let s = &self.settings;
         let both = material.transmits();
-        let direct = direct_light(self.scene, hit, n, brdf, s.shadow_rays, s.skip, both, sh.ctx);
+        // The glossy lobe's share of direct light is also found by its
+        // gather ray (MIS); the diffuse lobe's by shadow rays alone.
+        let mis = material.glossy().filter(|_| s.mis);
+        let direct = match mis {
+            Some(g) => {
+                let bsdf = |w: glam::Vec3| {
+                    let wi = frame.to_local(w);
+                    let shared = g.eval(wo, wi, entering, Transport::Radiance);
+                    let alone = (material.eval(wo, wi, entering, Transport::Radiance) - shared).max(Color::ZERO);
+                    MisBsdf { alone, shared, pdf: g.pdf(wo, wi, entering) }
+                };
+                direct_light_mis(self.scene, hit, n, bsdf, s.shadow_rays, s.skip, both, sh.ctx)
+            }
+            None => {
+                let brdf = |w: glam::Vec3| material.eval(wo, frame.to_local(w), entering, Transport::Radiance);
+                direct_light(self.scene, hit, n, brdf, s.shadow_rays, s.skip, both, sh.ctx)
+            }
+        };
         let (mut caustic, mut indirect) = (Color::ZERO, Color::ZERO);
         // Longer paths are the maps' and gathering's; a scene that limits
         // paths to two vertices has only direct light here (a limit of
-        // three or more is not offered for photon mapping).
+        // three or more is not offered for photon mapping), and the glossy
+        // lobe's sample adds only the light it meets.
         if self.scene.paths.max_depth.is_some() {
-            return self.checked(direct, "direct", sh);
+            let met = match mis {
+                Some(g) => self.glossy_light(hit, frame, g, wo, entering, sh),
+                None => Color::ZERO,
+            };
+            return self.checked(direct + met, "direct", sh);
         }
         if material.diffuse_rho().is_some() {
             let rho = material.diffuse_albedo(wo);
@@ -269,18 +298,56 @@ impl<'a> PhotonIntegrator<'a> {
             indirect = self.indirect(hit, n, rho, w, sh);
         }
         if let Some(g) = material.glossy() {
-            // One gather ray from the glossy lobe: indirect light it reflects.
+            // One gather ray from the glossy lobe: indirect light it
+            // reflects, and with MIS the direct light it meets.
             if let Some((wi, weight)) = g.sample(wo, entering, Transport::Radiance, sh.ctx.rng) {
                 let dir = frame.to_world(wi).normalize();
                 if hit.leaves_as(-frame.n, dir, wi.z > 0.0) {
                     let (next, dep) = hit.spawn(dir);
-                    indirect += weight * self.gather(next, dep, Lobe::Glossy, w * weight, sh);
+                    let sample = mis.map(|g| self.bsdf_sample(hit, n, g.pdf(wo, wi, entering)));
+                    indirect += weight * self.gather(next, dep, Lobe::Glossy, sample, w * weight, sh);
                 }
             }
         }
         self.checked(direct, "direct", sh)
             + self.checked(caustic, "caustic", sh)
             + self.checked(indirect, "indirect", sh)
+    }
+
+    /// What light a glossy lobe's gather ray meets needs for its MIS
+    /// weight.
+    fn bsdf_sample(&self, hit: &Hit, n: glam::Vec3, pdf: f32) -> BsdfSample {
+        BsdfSample { point: hit.point, normal: n, pdf, shadow_rays: self.settings.shadow_rays }
+    }
+
+    /// The light a sample of the glossy lobe meets straight from `hit`,
+    /// with its MIS weight (the share of direct light its shadow rays left
+    /// to it): a scene whose paths end there.
+    #[allow(clippy::too_many_arguments)]
+    fn glossy_light(
+        &self,
+        hit: &Hit,
+        frame: &Frame,
+        g: Glossy<'_>,
+        wo: glam::Vec3,
+        entering: bool,
+        sh: &mut Shade<'_, '_, 'a>,
+    ) -> Color {
+        let Some((wi, weight)) = g.sample(wo, entering, Transport::Radiance, sh.ctx.rng) else {
+            return Color::ZERO;
+        };
+        let dir = frame.to_world(wi).normalize();
+        if !hit.leaves_as(-frame.n, dir, wi.z > 0.0) {
+            return Color::ZERO;
+        }
+        let sample = self.bsdf_sample(hit, frame.n, g.pdf(wo, wi, entering));
+        let (ray, dep) = hit.spawn(dir);
+        sh.ctx.counters.rays += 1;
+        let met = match self.scene.intersect(&ray, Some(dep)) {
+            Some(y) => self.scene.transmittance(Some(dep), y.t) * sample.emitted(self.scene, &y, dir),
+            None => sample.from_infinity(&self.scene.lights, dir),
+        };
+        weight * met
     }
 
     /// Light → specular+ → x: the caustic map.
@@ -346,7 +413,7 @@ impl<'a> PhotonIntegrator<'a> {
             }
             let c = if aimed == 0 { 1.0 / nc } else { cos / (nc * cos + na * PI * sh.thread.aims.pdf(dir)) };
             let (ray, dep) = hit.spawn(dir);
-            sum += c * self.gather(ray, dep, Lobe::Diffuse, w * rho * c, sh);
+            sum += c * self.gather(ray, dep, Lobe::Diffuse, None, w * rho * c, sh);
         }
         rho * sum
     }
@@ -370,15 +437,27 @@ impl<'a> PhotonIntegrator<'a> {
     /// met, its diffuse lobe's light is read from the irradiance cache (the
     /// read left for later, with weight `w` and the path's), and its glossy
     /// lobe takes its direct light by shadow rays. Light met after mirrors
-    /// or glass counts only where the last non-specular vertex was glossy:
-    /// a diffuse one's is the caustic map's, and light met straight from a
-    /// non-specular vertex is its direct estimate's (notes/method.md).
+    /// or glass (a light's surface, or light from everywhere where the ray
+    /// leaves the scene) counts only where the last non-specular vertex was
+    /// glossy: a diffuse one's is the caustic map's. Light met straight
+    /// from a non-specular vertex is its direct estimate's, but where that
+    /// vertex shared its direct light with the lobe's sample (`shared`:
+    /// MIS at glossy lobes, [`super::mis`]): then it counts with the
+    /// sample's weight (notes/method.md).
     ///
     /// A glossy lobe that carries caustics ([`crate::material::Glossy`])
     /// stands for a specular one while the path is still a diffuse
     /// vertex's (`from` diffuse): the light it brings is the caustic map's,
     /// so it takes no shadow rays and is passed through like glass.
-    fn gather(&self, mut ray: Ray, mut dep: Departure, mut from: Lobe, w: Color, sh: &mut Shade<'_, '_, 'a>) -> Color {
+    fn gather(
+        &self,
+        mut ray: Ray,
+        mut dep: Departure,
+        mut from: Lobe,
+        mut shared: Option<BsdfSample>,
+        w: Color,
+        sh: &mut Shade<'_, '_, 'a>,
+    ) -> Color {
         let mut weight = Color::ONE;
         // A mirror or glass vertex since the last non-specular one.
         let mut specular = false;
@@ -386,12 +465,21 @@ impl<'a> PhotonIntegrator<'a> {
         for _ in 0..MAX_SPECULAR_DEPTH {
             sh.ctx.counters.rays += 1;
             let Some(y) = self.scene.intersect(&ray, Some(dep)) else {
+                // Light from everywhere: as a light's surface below.
+                if from == Lobe::Glossy && specular {
+                    found += weight * self.scene.background(ray.dir);
+                } else if let Some(b) = shared {
+                    found += weight * b.from_infinity(&self.scene.lights, ray.dir);
+                }
                 break;
             };
             weight *= self.scene.transmittance(Some(dep), y.t);
             let material = &self.scene.material_seen(&y, ray.dir);
             if from == Lobe::Glossy && specular {
                 found += weight * self.scene.emitted(&y, ray.dir);
+            } else if let Some(b) = shared {
+                // Straight from a glossy vertex that shared its direct light.
+                found += weight * b.emitted(self.scene, &y, ray.dir);
             }
             if material.is_emitter() {
                 break;
@@ -404,12 +492,6 @@ impl<'a> PhotonIntegrator<'a> {
             let glossy = material.glossy();
             // Whether the glossy lobe here is passed like glass.
             let caustic_glossy = from == Lobe::Diffuse && glossy.is_some_and(|g| g.carries_caustics());
-            if let Some(g) = glossy.filter(|_| !caustic_glossy) {
-                let brdf = |l: glam::Vec3| g.eval(wo, frame.to_local(l), entering, Transport::Radiance);
-                let s = &self.settings;
-                let both = g.transmits();
-                found += weight * direct_light(self.scene, &y, frame.n, brdf, s.shadow_rays, s.skip, both, sh.ctx);
-            }
             // On through one of the lobes that are not read here: a specular
             // branch or the glossy lobe, chosen by what each reflects.
             let branches = material.specular_branches(wo, entering, Transport::Radiance);
@@ -418,6 +500,27 @@ impl<'a> PhotonIntegrator<'a> {
                 Some(_) if branches.is_empty() => 0.0,
                 Some(g) => g.specular_share(),
             };
+            // The glossy lobe's direct light, shared with its sample (MIS)
+            // where the setting asks.
+            let lit = glossy.filter(|_| !caustic_glossy);
+            let mis = lit.filter(|_| self.settings.mis);
+            if let Some(g) = lit {
+                let s = &self.settings;
+                let both = g.transmits();
+                let direct = if mis.is_some() {
+                    let bsdf = |l: glam::Vec3| {
+                        let wi = frame.to_local(l);
+                        let shared = g.eval(wo, wi, entering, Transport::Radiance);
+                        MisBsdf { alone: Color::ZERO, shared, pdf: (1.0 - p_specular) * g.pdf(wo, wi, entering) }
+                    };
+                    direct_light_mis(self.scene, &y, frame.n, bsdf, s.shadow_rays, s.skip, both, sh.ctx)
+                } else {
+                    let brdf = |l: glam::Vec3| g.eval(wo, frame.to_local(l), entering, Transport::Radiance);
+                    direct_light(self.scene, &y, frame.n, brdf, s.shadow_rays, s.skip, both, sh.ctx)
+                };
+                found += weight * direct;
+            }
+            shared = None;
             let next_dir = if p_specular >= 1.0 || (p_specular > 0.0 && sh.ctx.rng.random::<f32>() < p_specular) {
                 let Some(b) = branches.choose(sh.ctx.rng) else { break };
                 weight *= b.scale / p_specular;
@@ -433,6 +536,15 @@ impl<'a> PhotonIntegrator<'a> {
                     specular = true;
                 } else {
                     (from, specular) = (Lobe::Glossy, false);
+                }
+                if let Some(g) = mis {
+                    let pdf = (1.0 - p_specular) * g.pdf(wo, wi, entering);
+                    shared = Some(BsdfSample {
+                        point: y.point,
+                        normal: frame.n,
+                        pdf,
+                        shadow_rays: self.settings.shadow_rays,
+                    });
                 }
                 frame.to_world(wi).normalize()
             };

@@ -47,6 +47,17 @@ impl Glossy<'_> {
         }
     }
 
+    /// The density (per solid angle) with which [`Self::sample`] returns
+    /// `wi`.
+    pub fn pdf(&self, wo: Vec3, wi: Vec3, entering: bool) -> f32 {
+        match self {
+            Glossy::Phong(p) => p.glossy_pdf(wo, wi),
+            Glossy::Conductor(c) => c.pdf(wo, wi),
+            Glossy::Dielectric(d) => d.pdf(wo, wi, entering),
+            Glossy::Coat(p) => p.coat_pdf(wo, wi),
+        }
+    }
+
     /// A direction from the glossy lobes alone and its weight f |cos| /
     /// pdf; `None` where the sample leaves on the wrong side. Phong's lobe
     /// draws two numbers, as it always has (the same images).

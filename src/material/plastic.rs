@@ -185,8 +185,12 @@ impl RoughPlastic {
         self.specular * (f * d * self.microfacet.g(wo, wi, h) / (4.0 * wo.z * wi.z))
     }
 
-    /// The coat's lobe's density: D(h) G1(wo, h) / (4 cos_o).
-    fn coat_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    /// The coat's lobe's density: D(h) G1(wo, h) / (4 cos_o) (of
+    /// [`Self::sample_coat`]'s directions, above the surface).
+    pub fn coat_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if !(wo.z > 0.0 && wi.z > 0.0) {
+            return 0.0;
+        }
         let h = (wo + wi).normalize();
         if !(wo.dot(h) > 0.0 && wi.dot(h) > 0.0) {
             return 0.0;

@@ -62,7 +62,8 @@ pub(crate) fn render_pass(
             shot
         }
         Method::Path => {
-            let integrator = PathIntegrator { scene, shadow_rays: settings.shadow_rays, skip: settings.skip };
+            let integrator =
+                PathIntegrator { scene, shadow_rays: settings.shadow_rays, skip: settings.skip, mis: true };
             let shot = camera_pass(&camera, &integrator, progress, rims);
             stats.camera_time = t.elapsed();
             shot

@@ -190,6 +190,7 @@ pub fn photon_integrator<'a>(
             skip: settings.skip,
             caustic_reuse: settings.caustic_reuse,
             defer_reads: true,
+            mis: true,
         },
     }
 }
