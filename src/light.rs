@@ -768,7 +768,7 @@ mod tests {
         let centroid = (t.v0 + t.v1 + t.v2) / 3.0;
         assert!((mean - centroid).length() < 0.01, "{mean} vs {centroid}");
         let x = centroid + t.normal * 1000.0;
-        let inc = Light::Area(light).incident(x, Vec2::splat(0.3)).unwrap();
+        let inc = Light::Area(light.clone()).incident(x, Vec2::splat(0.3)).unwrap();
         let want = 1.0 / 1000.0f32.powi(2);
         assert!((inc.intensity.x - want).abs() < 1e-3 * want);
         // From behind, nothing.

@@ -147,6 +147,7 @@ fn open_scene(paths: PathLimits) -> Scene {
         camera,
         one_sided: Vec::new(),
         paths,
+        texturing: Default::default(),
     })
 }
 
@@ -374,6 +375,7 @@ fn rough_glass_in_a_furnace_sees_the_sky_through_itself() {
         camera,
         one_sided: Vec::new(),
         paths: PathLimits::default(),
+        texturing: Default::default(),
     });
     let mean = |mis: bool| {
         let b = blocks(&PathIntegrator { scene: &scene, shadow_rays: 2, skip: true, mis }, &scene, 16, 50, 5);

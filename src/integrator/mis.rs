@@ -17,7 +17,6 @@
 //! (§9.2.4, fig. 9.8) measured it below the balance heuristic's variance
 //! in exactly these low-variance regions, never far above it elsewhere.
 
-use crate::light::Light;
 use crate::math::Color;
 use crate::scene::{Hit, Scene};
 use glam::Vec3;
@@ -55,34 +54,36 @@ pub struct BsdfSample {
 }
 
 impl BsdfSample {
-    /// Weight of light from `light` arriving along the sample, whose
-    /// shadow-ray density towards it is `pdf_light`.
+    /// Weight of light from the scene's light `index` arriving along the
+    /// sample, whose own sampling density towards it is `pdf_light`.
     #[inline]
-    fn weight(&self, pdf_light: f32) -> f32 {
-        power_heuristic(1.0, self.pdf, self.shadow_rays as f32, pdf_light)
+    fn weight(&self, scene: &Scene, index: usize, pdf_light: f32) -> f32 {
+        power_heuristic(1.0, self.pdf, scene.light_share(index, self.shadow_rays), pdf_light)
     }
 
     /// Radiance leaving the area light whose surface the sample met at
     /// `hit` (travelling along `dir`), weighted; zero for any other surface.
     #[inline(never)]
     pub fn emitted(&self, scene: &Scene, hit: &Hit, dir: Vec3) -> Color {
-        let Some(area) = scene.light_of(hit.prim) else { return Color::ZERO };
+        let (Some(area), Some(index)) = (scene.light_of(hit.prim), scene.light_index_of(hit.prim)) else {
+            return Color::ZERO;
+        };
         let le = scene.emitted(hit, dir);
         if le == Color::ZERO {
             return Color::ZERO;
         }
-        le * self.weight(area.pdf_at(self.point, hit.point))
+        le * self.weight(scene, index, area.pdf_at(self.point, hit.point))
     }
 
     /// Light from everywhere arriving along `dir` (the sample met
     /// nothing), each light at infinity weighted by its own density.
     #[inline(never)]
-    pub fn from_infinity(&self, lights: &[Light], dir: Vec3) -> Color {
+    pub fn from_infinity(&self, scene: &Scene, dir: Vec3) -> Color {
         let mut sum = Color::ZERO;
-        for light in lights {
+        for (index, light) in scene.lights.iter().enumerate() {
             let le = light.radiance_from_infinity(dir);
             if le != Color::ZERO {
-                sum += le * self.weight(light.pdf_around(self.point, self.normal, dir));
+                sum += le * self.weight(scene, index, light.pdf_around(self.point, self.normal, dir));
             }
         }
         sum

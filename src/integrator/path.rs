@@ -71,7 +71,7 @@ impl Integrator for PathIntegrator<'_> {
                 if count_emission && wanted && !hidden {
                     radiance += throughput * self.scene.background(ray.dir);
                 } else if let Some(b) = shared.filter(|_| wanted) {
-                    radiance += throughput * b.from_infinity(&self.scene.lights, ray.dir);
+                    radiance += throughput * b.from_infinity(self.scene, ray.dir);
                 }
                 break;
             };

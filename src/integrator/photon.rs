@@ -345,7 +345,7 @@ impl<'a> PhotonIntegrator<'a> {
         sh.ctx.counters.rays += 1;
         let met = match self.scene.intersect(&ray, Some(dep)) {
             Some(y) => self.scene.transmittance(Some(dep), y.t) * sample.emitted(self.scene, &y, dir),
-            None => sample.from_infinity(&self.scene.lights, dir),
+            None => sample.from_infinity(self.scene, dir),
         };
         weight * met
     }
@@ -469,7 +469,7 @@ impl<'a> PhotonIntegrator<'a> {
                 if from == Lobe::Glossy && specular {
                     found += weight * self.scene.background(ray.dir);
                 } else if let Some(b) = shared {
-                    found += weight * b.from_infinity(&self.scene.lights, ray.dir);
+                    found += weight * b.from_infinity(self.scene, ray.dir);
                 }
                 break;
             };

@@ -253,6 +253,10 @@ impl Texturing {
 /// Marks a primitive that is not a light's surface.
 const NO_LIGHT: u32 = u32::MAX;
 
+/// More lights than this are drawn by power for direct light, not visited
+/// one by one ([`Scene::many_lights`]).
+pub const MANY_LIGHTS: usize = 64;
+
 /// A light as a scene describes it, before the scene places it.
 #[derive(Clone, Debug)]
 pub enum LightSpec {
@@ -755,6 +759,48 @@ impl Scene {
     /// Bounding spheres of the objects with a mirror or glass lobe.
     pub fn specular_targets(&self) -> &[Target] {
         &self.targets
+    }
+
+    /// Whether direct light draws lights by power rather than visiting
+    /// each: a scene of more than [`MANY_LIGHTS`] (an emissive mesh is a
+    /// light per triangle), where visiting each would cost their number.
+    #[inline]
+    pub fn many_lights(&self) -> bool {
+        self.lights.len() > MANY_LIGHTS
+    }
+
+    /// The index of a light chosen by `u` in [0, 1) in proportion to its
+    /// power, and the chance of that choice.
+    #[inline]
+    pub fn pick_light_index(&self, u: f32) -> Option<(usize, f32)> {
+        let lights = self.light_pick.as_ref()?;
+        let i = lights.sample(u).0;
+        let p = lights.prob(i);
+        (p > 0.0).then_some((i, p))
+    }
+
+    /// What light `index`'s own sampling density is multiplied by in the
+    /// density of the shadow rays at a point that takes `count` of them
+    /// per light: `count` (1 for a delta light), or with many lights the
+    /// chance that any of the `count` draws picks it.
+    #[inline]
+    pub fn light_share(&self, index: usize, count: u32) -> f32 {
+        if self.many_lights() {
+            return count.max(1) as f32 * self.light_pick.as_ref().map_or(0.0, |l| l.prob(index));
+        }
+        if self.lights[index].is_delta() {
+            1.0
+        } else {
+            count as f32
+        }
+    }
+
+    /// The index of the area light whose surface primitive `prim` is.
+    pub fn light_index_of(&self, prim: u32) -> Option<usize> {
+        match self.prim_light[prim as usize] {
+            NO_LIGHT => None,
+            i => Some(i as usize),
+        }
     }
 
     /// A light chosen by `u` in [0, 1) in proportion to its power (largest

@@ -61,7 +61,10 @@ impl Builder<'_> {
 
 impl Builder<'_> {
     /// A texture for an emitter: its own copy (emitters hold theirs).
-    pub(super) fn emitter_texture(&mut self, t: &Plugin) -> Result<std::sync::Arc<crate::texture::Texture>, SceneError> {
+    pub(super) fn emitter_texture(
+        &mut self,
+        t: &Plugin,
+    ) -> Result<std::sync::Arc<crate::texture::Texture>, SceneError> {
         let i = self.texture(t)?;
         match &self.textures[i as usize] {
             super::textures::Draft::Ready(t) => Ok(std::sync::Arc::new(t.clone())),

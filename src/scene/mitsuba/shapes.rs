@@ -241,7 +241,9 @@ impl Builder<'_> {
                     self.prims.push(Prim { shape, material, object })
                 }
                 (Some(_), Shape::Disk(_)) if image.is_some() => {
-                    return Err(p.refuse("an emitting disk with a radiance texture is not supported yet (meshes and rectangles are)"))
+                    return Err(p.refuse(
+                        "an emitting disk with a radiance texture is not supported yet (meshes and rectangles are)",
+                    ))
                 }
                 (Some(radiance), Shape::Disk(d)) => {
                     self.lights.push(LightSpec::Area { surface: Emitting::Disk(d), radiance, material: Some(material) })
