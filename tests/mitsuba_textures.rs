@@ -172,6 +172,16 @@ fn a_mask_lets_the_rest_through() {
     assert!((centre - want).abs() < 0.02 * want, "{centre} vs {want}");
     let floor = 0.6 * 2.0 * cos / PI;
     assert!((film.get(1, 1)[1] as f64 - floor).abs() < 0.02 * floor, "{}", film.get(1, 1)[1]);
+    // Mitsuba's null BSDF: nothing there, the floor seen whole.
+    let null = text.replace(
+        r#"<bsdf type="mask"><float name="opacity" value="0.25"/>
+      <bsdf type="twosided"><bsdf type="diffuse"><rgb name="reflectance" value="0.2"/></bsdf></bsdf></bsdf>"#,
+        r#"<bsdf type="null"/>"#,
+    );
+    assert!(null.contains("null"));
+    let film = render(&write(&dir, "n.xml", &null), Method::Photon).unwrap();
+    let centre = film.get(8, 8)[1] as f64;
+    assert!((centre - floor).abs() < 1e-3 * floor, "{centre} vs {floor}");
 }
 
 /// A normal map's flat texel (0.5, 0.5, 1) changes nothing; one that tips

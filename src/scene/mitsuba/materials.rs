@@ -113,6 +113,13 @@ impl Builder<'_> {
                 }
                 return Ok((material, textured, one_sided, Some(perturb)));
             }
+            "null" => {
+                // Nothing there: light passes straight through (null.cpp), a
+                // mask of opacity 0 on both sides.
+                p.finish("nothing")?;
+                let nothing = crate::material::Masked { opacity: 0.0, rho: Color::ZERO };
+                return Ok((Material::Masked(nothing), None, false, None));
+            }
             "mask" => {
                 let opacity = self.param(p, "opacity", Use::Unbounded, Color::splat(0.5))?;
                 if let Param::Fixed(o) = opacity {
@@ -225,7 +232,7 @@ impl Builder<'_> {
             k => {
                 return Err(p.refuse(format!(
                     "the '{k}' BSDF is not supported yet (diffuse, dielectric, thindielectric, roughdielectric, \
-                     conductor, roughconductor, plastic, roughplastic, blendbsdf, mask, normalmap, bumpmap and twosided are)"
+                     conductor, roughconductor, plastic, roughplastic, blendbsdf, mask, null, normalmap, bumpmap and twosided are)"
                 )))
             }
         };

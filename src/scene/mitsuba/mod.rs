@@ -252,6 +252,14 @@ impl Builder<'_> {
                 tried.push(dir.join(p));
             }
             tried.push(from.file.parent().unwrap_or(Path::new(".")).join(p));
+            // Mitsuba's resolver holds the first scene file's folder too:
+            // a file named in an included file may be beside the scene.
+            if let Some(main) = self.inputs.first().and_then(|f| f.parent()) {
+                let beside = main.join(p);
+                if !tried.contains(&beside) {
+                    tried.push(beside);
+                }
+            }
         }
         match tried.iter().find(|t| t.is_file()) {
             Some(found) => {
