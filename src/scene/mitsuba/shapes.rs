@@ -255,7 +255,7 @@ impl Builder<'_> {
                     )))
                 }
             },
-            Mesh::Tris(t) => self.push_triangles(t, &to_world, flip, material, object, radiance, image),
+            Mesh::Tris(t) => self.push_triangles(t, &to_world, flip, material, object, radiance.map(|r| (r, image))),
         }
         Ok(())
     }
@@ -267,8 +267,7 @@ impl Builder<'_> {
         flip: bool,
         material: u32,
         object: u32,
-        radiance: Option<Color>,
-        image: Option<std::sync::Arc<crate::texture::Texture>>,
+        emits: Option<(Color, Option<std::sync::Arc<crate::texture::Texture>>)>,
     ) {
         let normal_map = to_world.matrix3.inverse().transpose();
         // A mirroring transform and flip_normals each turn the surface over.
@@ -295,8 +294,9 @@ impl Builder<'_> {
             if !(t.area() > 0.0) {
                 continue;
             }
-            if let Some(radiance) = radiance {
-                if let Some(texture) = &image {
+            if let Some((radiance, image)) = &emits {
+                let radiance = *radiance;
+                if let Some(texture) = image {
                     let pattern = crate::light::AreaPattern { texture: (**texture).clone(), uv };
                     self.light_patterns.resize(self.lights.len(), None);
                     self.light_patterns.push(Some(std::sync::Arc::new(pattern)));
