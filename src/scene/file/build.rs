@@ -13,7 +13,7 @@ use std::ops::Range;
 use toml::Spanned;
 
 /// Builds the scene from its checked structure.
-pub fn build(src: Source, def: FileDef) -> Result<SceneFile, SceneError> {
+pub fn build<'i>(src: Source<'i>, def: FileDef<'i>) -> Result<SceneFile, SceneError> {
     Builder {
         src,
         materials: Vec::new(),
@@ -61,7 +61,7 @@ pub const LIMIT: f32 = 1e15;
 /// divided by small areas in density estimates.
 pub const MAX_POWER: f64 = 1e30;
 
-impl Builder<'_> {
+impl<'a> Builder<'a> {
     pub(super) fn fail<T>(&self, span: Range<usize>, field: &str, message: impl Into<String>) -> Result<T, SceneError> {
         Err(self.src.error(span, field, message))
     }
@@ -114,48 +114,13 @@ impl Builder<'_> {
         Ok(x)
     }
 
-    /// A required field: missing fields are reported at the table's `type`.
-    pub(super) fn need<'v, T>(
-        &self,
-        v: &'v Option<Spanned<T>>,
-        owner: &At<String>,
-        name: &str,
-    ) -> Result<At<'v, T>, SceneError> {
-        let prefix = owner.field.trim_end_matches(".type");
-        match v {
-            Some(s) => Ok(at(s, format!("{prefix}.{name}"))),
-            None => self.fail(
-                owner.span.clone(),
-                &format!("{prefix}.{name}"),
-                format!("missing field `{name}` (required for type \"{}\")", owner.value),
-            ),
-        }
-    }
-
-    /// Fields that a type does not use are mistakes, not silently ignored.
-    pub(super) fn reject(
-        &self,
-        owner: &At<String>,
-        present: &[(&str, Option<Range<usize>>)],
-    ) -> Result<(), SceneError> {
-        let prefix = owner.field.trim_end_matches(".type");
-        if let Some((name, Some(span))) = present.iter().find(|(_, s)| s.is_some()) {
-            return self.fail(
-                span.clone(),
-                &format!("{prefix}.{name}"),
-                format!("field `{name}` does not apply to type \"{}\"", owner.value),
-            );
-        }
-        Ok(())
-    }
-
-    fn build(mut self, def: FileDef) -> Result<SceneFile, SceneError> {
-        for (name, m) in &def.materials {
-            let material = self.material(name, m)?;
+    fn build(mut self, def: FileDef<'a>) -> Result<SceneFile, SceneError> {
+        for (name, mut m) in def.materials {
+            let material = self.material(&mut m)?;
             if let Material::Phong(p) = material {
                 if p.albedo_bound() > 1.0 {
                     self.not_physical.push(self.src.error(
-                        m.get_ref().kind.span(),
+                        m.kind.span(),
                         format!("materials.{name}"),
                         format!(
                             "m_l C + m_s S + m_r C reaches {:.3} > 1: the material reflects more light than it \
@@ -166,18 +131,18 @@ impl Builder<'_> {
                 }
             }
             self.materials.push(material);
-            let place = self.place(m.get_ref().kind.span(), format!("materials.{name}"));
+            let place = self.place(m.kind.span(), format!("materials.{name}"));
             self.origins.materials.push(place);
-            self.names.insert(name.clone(), self.materials.len() as u32 - 1);
+            self.names.insert(name, self.materials.len() as u32 - 1);
         }
-        for (i, s) in def.shapes.iter().enumerate() {
-            let place = self.place(s.get_ref().kind.span(), format!("shapes[{i}]"));
+        for (i, s) in def.shapes.into_iter().enumerate() {
+            let place = self.place(s.kind.span(), format!("shapes[{i}]"));
             self.origins.objects.push(place);
             self.shape(i, s)?;
         }
-        for (i, l) in def.lights.iter().enumerate() {
+        for (i, l) in def.lights.into_iter().enumerate() {
+            let place = self.place(l.kind.span(), format!("lights[{i}]"));
             self.light(i, l)?;
-            let place = self.place(l.get_ref().kind.span(), format!("lights[{i}]"));
             self.origins.lights.push(place);
         }
         self.origins.camera = self.place(def.camera.span(), "camera".to_string());

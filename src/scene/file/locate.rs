@@ -1,7 +1,6 @@
 //! Where in the file a mistake is: byte spans turned into line and column,
 //! and the field named by its path in the scene's structure.
 
-use super::defs::FileDef;
 use super::SceneError;
 use std::ops::Range;
 use std::path::Path;
@@ -41,21 +40,9 @@ impl Source<'_> {
         (line, self.text[line_start..start].chars().count() + 1)
     }
 
-    /// The file's structure, or its first mistake: a syntax error from the
-    /// TOML parser, or a type, an unknown or a missing field from serde,
-    /// whose path in the structure names the field (serde_path_to_error).
-    pub fn deserialize(&self) -> Result<FileDef, SceneError> {
-        let de = toml::Deserializer::parse(self.text).map_err(|e| self.syntax_error(&e))?;
-        serde_path_to_error::deserialize(de).map_err(|e| {
-            let field = field_path(e.path());
-            let inner = e.into_inner();
-            self.error(inner.span().unwrap_or(0..0), field, inner.message().trim().to_string())
-        })
-    }
-
     /// A syntax error, named by the table it is in: the header on its own
     /// line (a duplicated `[camera]`), else the last header before it.
-    fn syntax_error(&self, e: &toml::de::Error) -> SceneError {
+    pub(super) fn syntax_error(&self, e: &toml::de::Error) -> SceneError {
         let span = e.span().unwrap_or(0..0);
         self.error(span.clone(), self.table_at(span.start), e.message().trim().to_string())
     }
@@ -80,9 +67,10 @@ impl Source<'_> {
     }
 }
 
-/// A path in the structure as the scene format names it, `shapes[0].radius`:
-/// the wrapper that carries each value's span is not a field of the format.
-fn field_path(path: &serde_path_to_error::Path) -> String {
+/// A path in the structure as the scene format names it, `radius` or
+/// `transform[1].scale` (empty: the value itself): the wrapper that carries
+/// each value's span is not a field of the format.
+pub(super) fn field_path(path: &serde_path_to_error::Path) -> String {
     use serde_path_to_error::Segment;
     let mut out = String::new();
     for segment in path.iter() {
@@ -98,11 +86,7 @@ fn field_path(path: &serde_path_to_error::Path) -> String {
             Segment::Unknown => {}
         }
     }
-    if out.is_empty() {
-        "(top level)".to_string()
-    } else {
-        out
-    }
+    out
 }
 
 #[cfg(test)]

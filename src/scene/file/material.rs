@@ -1,108 +1,70 @@
 //! `[materials.NAME]`: the materials a scene names, with their fields.
 
 use super::build::{at, At, Builder};
-use super::defs::V3;
+use super::defs::{Entry, V3};
 use super::SceneError;
 use crate::material::{Material, Phong};
 use crate::math::Color;
 use serde::Deserialize;
-use std::ops::Range;
 use toml::Spanned;
 
+/// `type = "lambertian"`: ideal diffuse.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct MaterialDef {
-    #[serde(rename = "type")]
-    pub kind: Spanned<String>,
-    pub rho: Option<Spanned<V3>>,
-    pub reflectance: Option<Spanned<V3>>,
-    pub ior: Option<Spanned<f32>>,
-    pub absorption: Option<Spanned<V3>>,
-    pub color: Option<Spanned<V3>>,
-    pub m_a: Option<Spanned<f32>>,
-    pub m_l: Option<Spanned<f32>>,
-    pub m_s: Option<Spanned<f32>>,
-    pub m_sm: Option<Spanned<f32>>,
-    pub m_sp: Option<Spanned<f32>>,
-    pub m_r: Option<Spanned<f32>>,
-    // Mitsuba 3's parameters of its conductors, dielectrics and plastics
-    // (read in mitsuba_bsdf.rs).
-    pub distribution: Option<Spanned<String>>,
-    pub alpha: Option<Spanned<f32>>,
-    pub alpha_u: Option<Spanned<f32>>,
-    pub alpha_v: Option<Spanned<f32>>,
-    pub eta: Option<Spanned<V3>>,
-    pub k: Option<Spanned<V3>>,
-    pub int_ior: Option<Spanned<f32>>,
-    pub ext_ior: Option<Spanned<f32>>,
-    pub specular_reflectance: Option<Spanned<V3>>,
-    pub specular_transmittance: Option<Spanned<V3>>,
-    pub diffuse_reflectance: Option<Spanned<V3>>,
-    pub nonlinear: Option<Spanned<bool>>,
+struct LambertianDef {
+    rho: Spanned<V3>,
 }
 
-/// Fields by name, with their places where given.
-pub(super) type Present = Vec<(&'static str, Option<Range<usize>>)>;
+/// `type = "mirror"`: a perfect mirror.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MirrorDef {
+    reflectance: Spanned<V3>,
+}
 
-impl MaterialDef {
-    /// Every field's name and, where given, its place.
-    pub(super) fn present(&self) -> Present {
-        fn span<T>(o: &Option<Spanned<T>>) -> Option<Range<usize>> {
-            o.as_ref().map(|s| s.span())
-        }
-        vec![
-            ("rho", span(&self.rho)),
-            ("reflectance", span(&self.reflectance)),
-            ("ior", span(&self.ior)),
-            ("absorption", span(&self.absorption)),
-            ("color", span(&self.color)),
-            ("m_a", span(&self.m_a)),
-            ("m_l", span(&self.m_l)),
-            ("m_s", span(&self.m_s)),
-            ("m_sm", span(&self.m_sm)),
-            ("m_sp", span(&self.m_sp)),
-            ("m_r", span(&self.m_r)),
-            ("distribution", span(&self.distribution)),
-            ("alpha", span(&self.alpha)),
-            ("alpha_u", span(&self.alpha_u)),
-            ("alpha_v", span(&self.alpha_v)),
-            ("eta", span(&self.eta)),
-            ("k", span(&self.k)),
-            ("int_ior", span(&self.int_ior)),
-            ("ext_ior", span(&self.ext_ior)),
-            ("specular_reflectance", span(&self.specular_reflectance)),
-            ("specular_transmittance", span(&self.specular_transmittance)),
-            ("diffuse_reflectance", span(&self.diffuse_reflectance)),
-            ("nonlinear", span(&self.nonlinear)),
-        ]
-    }
+/// `type = "glass"`: a smooth dielectric, optionally absorbing.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GlassDef {
+    ior: Spanned<f32>,
+    absorption: Option<Spanned<V3>>,
+}
+
+/// `type = "phong"`: the CS475 material.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PhongDef {
+    color: Spanned<V3>,
+    m_a: Option<Spanned<f32>>,
+    m_l: Option<Spanned<f32>>,
+    m_s: Option<Spanned<f32>>,
+    m_sm: Option<Spanned<f32>>,
+    m_sp: Option<Spanned<f32>>,
+    m_r: Option<Spanned<f32>>,
 }
 
 impl Builder<'_> {
-    pub(super) fn material(&self, name: &str, m: &Spanned<MaterialDef>) -> Result<Material, SceneError> {
-        let d = m.get_ref();
-        let f = |n: &str| format!("materials.{name}.{n}");
-        let kind = at(&d.kind, f("type"));
-        let others = |keep: &[&str]| -> Vec<(&str, Option<Range<usize>>)> {
-            d.present().into_iter().filter(|(n, _)| !keep.contains(n)).collect()
-        };
-        match kind.value.as_str() {
+    pub(super) fn material(&self, entry: &mut Entry) -> Result<Material, SceneError> {
+        let prefix = entry.field.clone();
+        let f = |n: &str| format!("{prefix}.{n}");
+        match entry.kind.get_ref().as_str() {
             "lambertian" => {
-                self.reject(&kind, &others(&["rho"]))?;
-                let rho = self.color(&self.need(&d.rho, &kind, "rho")?)?;
-                self.albedo(rho, &self.need(&d.rho, &kind, "rho")?)?;
-                Ok(Material::Lambertian { rho })
+                let d: LambertianDef = entry.read(&self.src)?;
+                let rho = at(&d.rho, f("rho"));
+                let c = self.color(&rho)?;
+                self.albedo(c, &rho)?;
+                Ok(Material::Lambertian { rho: c })
             }
             "mirror" => {
-                self.reject(&kind, &others(&["reflectance"]))?;
-                let r = self.need(&d.reflectance, &kind, "reflectance")?;
+                let d: MirrorDef = entry.read(&self.src)?;
+                let r = at(&d.reflectance, f("reflectance"));
                 let reflectance = self.color(&r)?;
                 self.albedo(reflectance, &r)?;
                 Ok(Material::Mirror { reflectance })
             }
             "glass" => {
-                self.reject(&kind, &others(&["ior", "absorption"]))?;
-                let ior = self.number(&self.need(&d.ior, &kind, "ior")?, 0.0, 10.0, true)?;
+                let d: GlassDef = entry.read(&self.src)?;
+                let ior = self.number(&at(&d.ior, f("ior")), 0.0, 10.0, true)?;
                 let absorption = match &d.absorption {
                     Some(a) => self.color(&at(a, f("absorption")))?,
                     None => Color::ZERO,
@@ -110,8 +72,8 @@ impl Builder<'_> {
                 Ok(Material::Glass { ior, absorption })
             }
             "phong" => {
-                self.reject(&kind, &others(&["color", "m_a", "m_l", "m_s", "m_sm", "m_sp", "m_r"]))?;
-                let color = self.color(&self.need(&d.color, &kind, "color")?)?;
+                let d: PhongDef = entry.read(&self.src)?;
+                let color = self.color(&at(&d.color, f("color")))?;
                 let coef = |v: &Option<Spanned<f32>>, n: &str, hi: f32| -> Result<f32, SceneError> {
                     match v {
                         Some(s) => self.number(&at(s, f(n)), 0.0, hi, false),
@@ -128,17 +90,21 @@ impl Builder<'_> {
                     mirror: coef(&d.m_r, "m_r", f32::INFINITY)?,
                 }))
             }
-            "conductor" | "roughconductor" | "roughdielectric" | "thindielectric" | "plastic" | "roughplastic" => {
-                self.mitsuba_bsdf(&kind, d, &others)
-            }
-            other => self.fail(
-                kind.span.clone(),
-                &kind.field,
-                format!(
-                    "unknown material type \"{other}\" (lambertian, mirror, glass, phong, conductor, roughconductor, \
-                     roughdielectric, thindielectric, plastic, roughplastic)"
-                ),
-            ),
+            _ => match self.mitsuba_bsdf(entry)? {
+                Some(m) => Ok(m),
+                None => {
+                    let kind = entry.kind();
+                    self.fail(
+                        kind.span.clone(),
+                        &kind.field,
+                        format!(
+                            "unknown material type \"{}\" (lambertian, mirror, glass, phong, conductor, \
+                             roughconductor, roughdielectric, thindielectric, plastic, roughplastic)",
+                            kind.value
+                        ),
+                    )
+                }
+            },
         }
     }
 
@@ -150,14 +116,14 @@ impl Builder<'_> {
         Ok(())
     }
 
-    pub(super) fn material_ref(&self, kind: &At<String>, m: &Option<Spanned<String>>) -> Result<u32, SceneError> {
-        let name = self.need(m, kind, "material")?;
-        self.names.get(name.value.as_str()).copied().ok_or_else(|| {
+    /// The index of the material named at `name` (the field `field`).
+    pub(super) fn material_ref(&self, name: &Spanned<String>, field: String) -> Result<u32, SceneError> {
+        self.names.get(name.get_ref().as_str()).copied().ok_or_else(|| {
             let known: Vec<&str> = self.names.keys().map(String::as_str).collect();
             self.src.error(
-                name.span.clone(),
-                name.field.clone(),
-                format!("no material named \"{}\" (defined: {})", name.value, known.join(", ")),
+                name.span(),
+                field,
+                format!("no material named \"{}\" (defined: {})", name.get_ref(), known.join(", ")),
             )
         })
     }

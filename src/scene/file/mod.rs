@@ -2,6 +2,11 @@
 //! and turned into [`SceneParts`] ([`build`]). The format's reference is
 //! notes/scene-format.md; the built-in room is `scenes/tncg15.toml`.
 //!
+//! A table with a `type` (a material, a shape, a light) is read as that
+//! type's own struct, defined beside the code that builds it
+//! ([`defs::Entry`]): a new field of a type is a line of its struct, a new
+//! type a struct and an arm of its section's `match`.
+//!
 //! Every value is read with its byte span, so a mistake is reported as
 //! `file:line:column: field: what is wrong` ([`locate`]), whether the TOML
 //! parser found it (a syntax error), serde (a type, an unknown or missing
@@ -99,5 +104,5 @@ pub fn load(path: &Path) -> Result<SceneFile, SceneError> {
 pub fn parse(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
     let line_starts = locate::line_starts(text);
     let src = Source { path, text, line_starts: &line_starts };
-    build::build(src, src.deserialize()?)
+    build::build(src, defs::FileDef::read(&src)?)
 }

@@ -1,7 +1,7 @@
 //! `[[shapes]]`: geometry, each of a named material or emissive.
 
 use super::build::{at, At, Builder};
-use super::defs::V3;
+use super::defs::{Entry, V3};
 use super::SceneError;
 use crate::light::Emitting;
 use crate::math::Color;
@@ -14,23 +14,69 @@ use std::ops::Range;
 use std::path::Path;
 use toml::Spanned;
 
+/// `type = "triangle"` and `"quad"`: three or four corners (a quad's in
+/// one plane), of a material, or emissive (`emission`), or both.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ShapeDef {
-    #[serde(rename = "type")]
-    pub kind: Spanned<String>,
-    pub material: Option<Spanned<String>>,
-    pub emission: Option<Spanned<V3>>,
-    pub vertices: Option<Spanned<Vec<V3>>>,
-    pub center: Option<Spanned<V3>>,
-    pub radius: Option<Spanned<f32>>,
-    pub normal: Option<Spanned<V3>>,
-    pub file: Option<Spanned<String>>,
-    pub face_normals: Option<Spanned<bool>>,
-    pub transform: Option<Vec<Spanned<StepDef>>>,
-    pub floor: Option<Spanned<String>>,
-    pub ceiling: Option<Spanned<String>>,
-    pub walls: Option<Spanned<Vec<Spanned<String>>>>,
+struct Polygon {
+    material: Option<Spanned<String>>,
+    emission: Option<Spanned<V3>>,
+    vertices: Spanned<Vec<V3>>,
+}
+
+/// `type = "mesh"`: an OBJ file's triangles, transformed.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Mesh {
+    material: Option<Spanned<String>>,
+    emission: Option<Spanned<V3>>,
+    file: Spanned<String>,
+    face_normals: Option<Spanned<bool>>,
+    transform: Option<Vec<Spanned<StepDef>>>,
+}
+
+/// `type = "sphere"`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SphereDef {
+    material: Spanned<String>,
+    center: Spanned<V3>,
+    radius: Spanned<f32>,
+}
+
+/// `type = "ellipsoid"`: the unit sphere transformed (CS475's).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EllipsoidDef {
+    material: Spanned<String>,
+    transform: Option<Vec<Spanned<StepDef>>>,
+}
+
+/// `type = "tetrahedron"`: four corners.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TetrahedronDef {
+    material: Spanned<String>,
+    vertices: Spanned<Vec<V3>>,
+}
+
+/// `type = "disk"`: a flat disk.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DiskDef {
+    material: Spanned<String>,
+    center: Spanned<V3>,
+    normal: Spanned<V3>,
+    radius: Spanned<f32>,
+}
+
+/// `type = "room"`: the TNCG15 hexagonal room.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RoomDef {
+    floor: Spanned<String>,
+    ceiling: Spanned<String>,
+    walls: Spanned<Vec<Spanned<String>>>,
 }
 
 #[derive(Deserialize)]
@@ -81,66 +127,35 @@ impl Builder<'_> {
         Ok(m)
     }
 
-    pub(super) fn shape(&mut self, i: usize, s: &Spanned<ShapeDef>) -> Result<(), SceneError> {
-        let d = s.get_ref();
-        let kind = at(&d.kind, format!("shapes[{i}].type"));
-        let present = [
-            ("material", d.material.as_ref().map(|x| x.span())),
-            ("emission", d.emission.as_ref().map(|x| x.span())),
-            ("vertices", d.vertices.as_ref().map(|x| x.span())),
-            ("center", d.center.as_ref().map(|x| x.span())),
-            ("radius", d.radius.as_ref().map(|x| x.span())),
-            ("normal", d.normal.as_ref().map(|x| x.span())),
-            ("file", d.file.as_ref().map(|x| x.span())),
-            ("face_normals", d.face_normals.as_ref().map(|x| x.span())),
-            ("transform", d.transform.as_ref().and_then(|x| x.first()).map(|x| x.span())),
-            ("floor", d.floor.as_ref().map(|x| x.span())),
-            ("ceiling", d.ceiling.as_ref().map(|x| x.span())),
-            ("walls", d.walls.as_ref().map(|x| x.span())),
-        ];
-        let only = |keep: &[&str]| -> Vec<(&str, Option<Range<usize>>)> {
-            present.iter().filter(|(n, _)| !keep.contains(n)).cloned().collect()
-        };
+    pub(super) fn shape(&mut self, i: usize, mut entry: Entry) -> Result<(), SceneError> {
         let f = |n: &str| format!("shapes[{i}].{n}");
-        // A triangle or mesh with `emission` is a light; with a material too
-        // it also reflects (a glowing surface).
-        let emission = match &d.emission {
-            Some(e) => Some(self.color(&at(e, f("emission")))?),
-            None => None,
-        };
-        let vertices = |n: usize| -> Result<Vec<Vec3>, SceneError> {
-            let v = self.need(&d.vertices, &kind, "vertices")?;
-            if v.value.len() != n {
-                return self.fail(v.span, &v.field, format!("needs {n} vertices, got {}", v.value.len()));
-            }
-            v.value
-                .iter()
-                .map(|p| self.finite(&At { value: p, span: v.span.clone(), field: v.field.clone() }))
-                .collect()
-        };
-        match kind.value.as_str() {
-            "triangle" => {
-                self.reject(&kind, &only(&["material", "emission", "vertices"]))?;
-                let v = vertices(3)?;
-                let t = Triangle::new(v[0], v[1], v[2]);
-                self.triangles(i, &kind, &d.material, emission, &[t], None, &d.vertices)?;
-            }
-            "quad" => {
-                self.reject(&kind, &only(&["material", "emission", "vertices"]))?;
-                let v = vertices(4)?;
-                // Planar: the fourth corner on the plane of the first three.
-                let n = (v[1] - v[0]).cross(v[2] - v[0]);
-                let size = (v[2] - v[0]).length().max((v[3] - v[1]).length());
-                if !((v[3] - v[0]).dot(n.normalize_or_zero()).abs() <= 1e-4 * size) {
-                    let span = d.vertices.as_ref().map_or(kind.span.clone(), |v| v.span());
-                    return self.fail(span, &f("vertices"), "the four corners of a quad must lie in one plane");
-                }
-                let quad = [Triangle::new(v[0], v[1], v[2]), Triangle::new(v[0], v[2], v[3])];
-                self.triangles(i, &kind, &d.material, emission, &quad, None, &d.vertices)?;
+        let kind = entry.kind.get_ref().clone();
+        let kind_span = entry.kind.span();
+        let object = i as u32;
+        match kind.as_str() {
+            "triangle" | "quad" => {
+                let d: Polygon = entry.read(&self.src)?;
+                let emission = self.emission(i, &d.emission)?;
+                let n = if kind == "triangle" { 3 } else { 4 };
+                let v = self.vertices(&d.vertices, f("vertices"), n)?;
+                let triangles = if n == 3 {
+                    vec![Triangle::new(v[0], v[1], v[2])]
+                } else {
+                    // Planar: the fourth corner on the plane of the first three.
+                    let normal = (v[1] - v[0]).cross(v[2] - v[0]);
+                    let size = (v[2] - v[0]).length().max((v[3] - v[1]).length());
+                    if !((v[3] - v[0]).dot(normal.normalize_or_zero()).abs() <= 1e-4 * size) {
+                        let span = d.vertices.span();
+                        return self.fail(span, &f("vertices"), "the four corners of a quad must lie in one plane");
+                    }
+                    vec![Triangle::new(v[0], v[1], v[2]), Triangle::new(v[0], v[2], v[3])]
+                };
+                self.triangles(i, &d.material, emission, &triangles, None, d.vertices.span())?;
             }
             "mesh" => {
-                self.reject(&kind, &only(&["material", "emission", "file", "face_normals", "transform"]))?;
-                let file = self.need(&d.file, &kind, "file")?;
+                let d: Mesh = entry.read(&self.src)?;
+                let emission = self.emission(i, &d.emission)?;
+                let file = at(&d.file, f("file"));
                 let m = self.transform(i, &d.transform)?;
                 let obj_path = self.src.path.parent().unwrap_or(Path::new(".")).join(file.value);
                 let mesh = load_obj(&obj_path).map_err(|e| self.src.error(file.span.clone(), file.field.clone(), e))?;
@@ -166,73 +181,57 @@ impl Builder<'_> {
                         })
                         .collect::<Vec<_>>()
                 });
-                self.triangles(i, &kind, &d.material, emission, &triangles, normals.as_deref(), &d.vertices)?;
-            }
-            "sphere" | "ellipsoid" | "tetrahedron" | "disk" | "room" if emission.is_some() => {
-                let e = d.emission.as_ref().map(|e| e.span()).unwrap_or(kind.span.clone());
-                return self.fail(
-                    e,
-                    &f("emission"),
-                    "only triangles and meshes can be made emissive (or use a disk light)",
-                );
+                self.triangles(i, &d.material, emission, &triangles, normals.as_deref(), kind_span)?;
             }
             "sphere" => {
-                self.reject(&kind, &only(&["material", "center", "radius"]))?;
-                let material = self.material_ref(&kind, &d.material)?;
-                let center = self.finite(&self.need(&d.center, &kind, "center")?)?;
-                let radius = self.number(&self.need(&d.radius, &kind, "radius")?, 0.0, f32::INFINITY, true)?;
-                self.prims.push(Prim { shape: Shape::Sphere(Sphere { center, radius }), material, object: i as u32 });
+                let d: SphereDef = self.read_shape(&mut entry)?;
+                let material = self.material_ref(&d.material, f("material"))?;
+                let center = self.finite(&at(&d.center, f("center")))?;
+                let radius = self.number(&at(&d.radius, f("radius")), 0.0, f32::INFINITY, true)?;
+                self.prims.push(Prim { shape: Shape::Sphere(Sphere { center, radius }), material, object });
             }
             "ellipsoid" => {
-                self.reject(&kind, &only(&["material", "transform"]))?;
-                let material = self.material_ref(&kind, &d.material)?;
+                let d: EllipsoidDef = self.read_shape(&mut entry)?;
+                let material = self.material_ref(&d.material, f("material"))?;
                 let m = self.transform(i, &d.transform)?;
                 let e = Ellipsoid::new(m)
-                    .ok_or_else(|| self.src.error(kind.span.clone(), f("transform"), "the transform is singular"))?;
-                self.prims.push(Prim { shape: Shape::Ellipsoid(e), material, object: i as u32 });
+                    .ok_or_else(|| self.src.error(kind_span.clone(), f("transform"), "the transform is singular"))?;
+                self.prims.push(Prim { shape: Shape::Ellipsoid(e), material, object });
             }
             "tetrahedron" => {
-                self.reject(&kind, &only(&["material", "vertices"]))?;
-                let material = self.material_ref(&kind, &d.material)?;
-                let v = vertices(4)?;
+                let d: TetrahedronDef = self.read_shape(&mut entry)?;
+                let material = self.material_ref(&d.material, f("material"))?;
+                let v = self.vertices(&d.vertices, f("vertices"), 4)?;
                 for t in tetrahedron(v[0], v[1], v[2], v[3]) {
-                    self.prims.push(Prim { shape: Shape::Triangle(t), material, object: i as u32 });
+                    self.prims.push(Prim { shape: Shape::Triangle(t), material, object });
                 }
             }
             "disk" => {
-                self.reject(&kind, &only(&["material", "center", "normal", "radius"]))?;
-                let material = self.material_ref(&kind, &d.material)?;
-                let center = self.finite(&self.need(&d.center, &kind, "center")?)?;
-                let normal = self.direction(&self.need(&d.normal, &kind, "normal")?)?;
-                let radius = self.number(&self.need(&d.radius, &kind, "radius")?, 0.0, f32::INFINITY, true)?;
-                self.prims.push(Prim {
-                    shape: Shape::Disk(Disk { center, normal, radius }),
-                    material,
-                    object: i as u32,
-                });
+                let d: DiskDef = self.read_shape(&mut entry)?;
+                let material = self.material_ref(&d.material, f("material"))?;
+                let center = self.finite(&at(&d.center, f("center")))?;
+                let normal = self.direction(&at(&d.normal, f("normal")))?;
+                let radius = self.number(&at(&d.radius, f("radius")), 0.0, f32::INFINITY, true)?;
+                self.prims.push(Prim { shape: Shape::Disk(Disk { center, normal, radius }), material, object });
             }
             "room" => {
-                self.reject(&kind, &only(&["floor", "ceiling", "walls"]))?;
-                let floor = self.material_ref(&kind, &d.floor)?;
-                let ceiling = self.material_ref(&kind, &d.ceiling)?;
-                let walls_def = self.need(&d.walls, &kind, "walls")?;
-                if walls_def.value.len() != 6 {
-                    return self.fail(
-                        walls_def.span,
-                        &walls_def.field,
-                        format!("needs 6 wall materials, got {}", walls_def.value.len()),
-                    );
+                let d: RoomDef = self.read_shape(&mut entry)?;
+                let floor = self.material_ref(&d.floor, f("floor"))?;
+                let ceiling = self.material_ref(&d.ceiling, f("ceiling"))?;
+                if d.walls.get_ref().len() != 6 {
+                    let n = d.walls.get_ref().len();
+                    return self.fail(d.walls.span(), &f("walls"), format!("needs 6 wall materials, got {n}"));
                 }
                 let mut walls = [0u32; 6];
-                for (w, name) in walls.iter_mut().zip(walls_def.value.iter()) {
-                    *w = self.material_ref(&kind, &Some(name.clone()))?;
+                for (w, name) in walls.iter_mut().zip(d.walls.get_ref()) {
+                    *w = self.material_ref(name, f("walls"))?;
                 }
-                self.prims.extend(tncg15_room(floor, ceiling, walls, i as u32));
+                self.prims.extend(tncg15_room(floor, ceiling, walls, object));
             }
             other => {
                 return self.fail(
-                    kind.span.clone(),
-                    &kind.field,
+                    kind_span,
+                    &f("type"),
                     format!(
                     "unknown shape type \"{other}\" (triangle, quad, mesh, sphere, ellipsoid, tetrahedron, disk, room)"
                 ),
@@ -242,19 +241,40 @@ impl Builder<'_> {
         Ok(())
     }
 
+    /// A shape that cannot emit: `emission` is refused with what can.
+    fn read_shape<T: serde::de::DeserializeOwned>(&self, entry: &mut Entry) -> Result<T, SceneError> {
+        entry.read(&self.src).map_err(|mut e| {
+            if e.field.ends_with(".emission") && e.message.starts_with("unknown field") {
+                e.message = "only triangles and meshes can be made emissive (or use a disk light)".into();
+            }
+            e
+        })
+    }
+
+    /// A shape's `emission`, where given: it makes the shape a light.
+    fn emission(&self, i: usize, e: &Option<Spanned<V3>>) -> Result<Option<Color>, SceneError> {
+        e.as_ref().map(|e| self.color(&at(e, format!("shapes[{i}].emission")))).transpose()
+    }
+
+    /// `n` corners.
+    fn vertices(&self, v: &Spanned<Vec<V3>>, field: String, n: usize) -> Result<Vec<Vec3>, SceneError> {
+        if v.get_ref().len() != n {
+            return self.fail(v.span(), &field, format!("needs {n} vertices, got {}", v.get_ref().len()));
+        }
+        v.get_ref().iter().map(|p| self.finite(&At { value: p, span: v.span(), field: field.clone() })).collect()
+    }
+
     /// Triangles of a triangle or mesh shape: lights when emissive, else
     /// primitives of the named material. Zero-area triangles are dropped.
     /// Triangles of shape `i` (with their vertex normals, if smooth).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn triangles(
         &mut self,
         i: usize,
-        kind: &At<String>,
         material: &Option<Spanned<String>>,
         emission: Option<Color>,
         triangles: &[Triangle],
         normals: Option<&[[Vec3; 3]]>,
-        vertices: &Option<Spanned<Vec<V3>>>,
+        span: Range<usize>,
     ) -> Result<(), SceneError> {
         let mut kept = Vec::with_capacity(triangles.len());
         for (j, t) in triangles.iter().enumerate() {
@@ -269,13 +289,13 @@ impl Builder<'_> {
             kept.push(t);
         }
         if kept.is_empty() {
-            let span = vertices.as_ref().map_or(kind.span.clone(), |v| v.span());
-            return self.fail(span, &kind.field.replace(".type", ""), "has no triangle of non-zero area");
+            return self.fail(span, &format!("shapes[{i}]"), "has no triangle of non-zero area");
         }
+        let field = format!("shapes[{i}].material");
         match emission {
             Some(radiance) => {
                 let material = match material {
-                    Some(_) => Some(self.material_ref(kind, material)?),
+                    Some(m) => Some(self.material_ref(m, field)?),
                     None => None,
                 };
                 let place = self.origins.objects[i].clone();
@@ -285,7 +305,13 @@ impl Builder<'_> {
                 }
             }
             None => {
-                let material = self.material_ref(kind, material)?;
+                let Some(m) = material else {
+                    // Said at the shape's `type`, as any missing field.
+                    let mut place = self.origins.objects[i].clone();
+                    place.field += ".material";
+                    return Err(self.origins.error(&place, "missing field `material` (required without `emission`)"));
+                };
+                let material = self.material_ref(m, field)?;
                 let object = i as u32;
                 self.prims.extend(kept.into_iter().map(|t| Prim { shape: Shape::Triangle(t), material, object }));
             }
