@@ -14,7 +14,7 @@ fn main() {
         return mesh_scene();
     }
     let scene = Scene::tncg15(Eye::One);
-    let shapes: Vec<_> = (0..scene.prim_count() as u32).map(|i| *scene.shape(i)).collect();
+    let shapes: Vec<_> = (0..scene.prim_count() as u32).map(|i| scene.shape(i).clone()).collect();
     let rays = random_rays(Vec3::new(-2.0, -5.0, -4.5), Vec3::new(12.0, 5.0, 4.5), 2_000_000, 1);
     // The course's Möller–Trumbore over the same primitives (spheres and the
     // disk through their own tests), to price the watertight test.
@@ -65,7 +65,7 @@ fn main() {
 /// eye 1 and random rays, with the BVH and without it (a flat loop).
 fn mesh_scene() {
     let scene = Scene::tncg15(Eye::One);
-    let mut shapes: Vec<Shape> = (0..scene.prim_count() as u32).map(|i| *scene.shape(i)).collect();
+    let mut shapes: Vec<Shape> = (0..scene.prim_count() as u32).map(|i| scene.shape(i).clone()).collect();
     let torus = photonmap::scene::procedural::torus(glam::Vec3::new(8.0, 0.0, -2.0), 2.2, 0.8, 250, 200).triangles();
     shapes.extend(torus.iter().map(|[a, b, c]| Shape::Triangle(Triangle::new(*a, *b, *c))));
     println!("\nmesh scene: {} primitives (100,000 torus triangles + the room)", shapes.len());

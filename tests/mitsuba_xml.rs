@@ -99,7 +99,7 @@ fn includes_defaults_and_parameters() {
     );
     let main =
         write(&dir, "main.xml", &scene(r#"<default name="r" value="0.5"/><include filename="parts/ball.xml"/>"#));
-    let radius = |d: &[(&str, &str)]| match read(&main, d).unwrap().file.parts.prims[0].shape {
+    let radius = |d: &[(&str, &str)]| match read(&main, d).unwrap().file.parts.prims[0].shape.clone() {
         Shape::Sphere(s) => s.radius,
         other => panic!("{other:?}"),
     };
@@ -560,7 +560,7 @@ fn cylinders_follow_p0_p1_radius_and_to_world() {
     };
     let get = |name: &str, text: String| {
         let parts = read(&write(&dir, name, &text), &[]).map(|i| i.file.parts);
-        parts.map(|p| match p.prims.iter().map(|p| p.shape).collect::<Vec<_>>()[..] {
+        parts.map(|p| match p.prims.iter().map(|p| p.shape.clone()).collect::<Vec<_>>()[..] {
             [Shape::Cylinder(c)] => c,
             ref other => panic!("{other:?}"),
         })

@@ -115,7 +115,7 @@ fn moller_trumbore(scene: &Scene, ray: &Ray) -> Option<(u32, f32)> {
     let mut best: Option<(u32, f32)> = None;
     for i in 0..scene.prim_count() {
         let limit = best.map_or(f32::INFINITY, |b| b.1);
-        let t = match *scene.shape(i as u32) {
+        let t = match scene.shape(i as u32) {
             Shape::Triangle(t) => t.moller_trumbore(ray, limit).map(|h| h.0),
             other => other.intersect(ray, limit, None).map(|h| h.t),
         };
@@ -403,7 +403,7 @@ fn degenerate_input_renders_finite_images() {
         Shape::Triangle(Triangle::new(p, p + Vec3::Z, p + Vec3::Z + Vec3::X * 1e-7)),
         Shape::Sphere(Sphere { center: Vec3::new(6.0, 0.0, -4.0), radius: 0.0 }),
     ];
-    parts.prims.extend(degenerate.iter().map(|&shape| Prim { shape, material: grey, object: 0 }));
+    parts.prims.extend(degenerate.iter().map(|shape| Prim { shape: shape.clone(), material: grey, object: 0 }));
     // A zero-radius glass sphere (an aiming target with no size) and a floor
     // triangle duplicated with another material (coincident faces).
     parts.materials.push(Material::glass(1.5));
@@ -413,7 +413,7 @@ fn degenerate_input_renders_finite_images() {
         material: glass,
         object: 0,
     });
-    let mut copy = parts.prims[0];
+    let mut copy = parts.prims[0].clone();
     copy.material = 3;
     parts.prims.push(copy);
     render_parts(parts.clone(), &small(20_000));

@@ -347,7 +347,7 @@ impl Enclosure {
         let step = ray.dir * h.t;
         let point = ray.origin + step;
         let p_err = gamma(7) * (ray.origin.abs() + step.abs() + Vec3::splat(f.d.abs()));
-        (f.prim, ShapeHit { t: h.t, point, p_err, normal: f.normal, uv: [0.0; 2], shading: FLAT })
+        (f.prim, ShapeHit { t: h.t, point, p_err, normal: f.normal, uv: [0.0; 2], shading: FLAT, shading_normal: None })
     }
 }
 
@@ -419,7 +419,7 @@ mod tests {
 
     fn room_shapes() -> (Vec<Shape>, Vec<Option<u32>>) {
         let parts = Scene::tncg15_parts(Eye::One);
-        let shapes: Vec<Shape> = parts.prims.iter().map(|p| p.shape).collect();
+        let shapes: Vec<Shape> = parts.prims.iter().map(|p| p.shape.clone()).collect();
         let group = parts.prims.iter().map(|p| Some(p.material)).collect();
         (shapes, group)
     }
@@ -499,7 +499,7 @@ mod tests {
         assert!(Enclosure::detect(&bent, &group).is_none());
         // Without the ceiling the polyhedron is open.
         let open: Vec<Shape> =
-            shapes.iter().enumerate().filter(|(i, _)| !(6..12).contains(i)).map(|(_, s)| *s).collect();
+            shapes.iter().enumerate().filter(|(i, _)| !(6..12).contains(i)).map(|(_, s)| s.clone()).collect();
         let og: Vec<Option<u32>> =
             group.iter().enumerate().filter(|(i, _)| !(6..12).contains(i)).map(|(_, g)| *g).collect();
         assert!(Enclosure::detect(&open, &og).is_none());

@@ -78,7 +78,7 @@ impl Accel {
         for (k, &i) in order.iter().enumerate() {
             slot[i as usize] = k as u32;
         }
-        let shapes = order.iter().map(|&i| (shapes[i as usize], i)).collect();
+        let shapes = order.iter().map(|&i| (shapes[i as usize].clone(), i)).collect();
         Accel { bvh, shapes, searched: count, slot, enclosure }
     }
 
@@ -218,7 +218,7 @@ mod tests {
     fn the_enclosure_finds_what_the_triangles_find() {
         use crate::scene::{Eye, Scene};
         let parts = Scene::tncg15_parts(Eye::One);
-        let shapes: Vec<Shape> = parts.prims.iter().map(|p| p.shape).collect();
+        let shapes: Vec<Shape> = parts.prims.iter().map(|p| p.shape.clone()).collect();
         let group: Vec<Option<u32>> = parts.prims.iter().map(|p| Some(p.material)).collect();
         let plain = Accel::new(shapes.clone());
         let fast = Accel::with_enclosure(shapes.clone(), &group);
@@ -316,7 +316,7 @@ mod tests {
         use crate::math::offset_ray_origin;
         use crate::scene::{Eye, Scene};
         let parts = Scene::tncg15_parts(Eye::One);
-        let room: Vec<Shape> = parts.prims[..24].iter().map(|p| p.shape).collect();
+        let room: Vec<Shape> = parts.prims[..24].iter().map(|p| p.shape.clone()).collect();
         let group: Vec<Option<u32>> = vec![Some(0); 24];
         let plain = Accel::new(room.clone());
         let fast = Accel::with_enclosure(room.clone(), &group);
@@ -354,7 +354,7 @@ mod tests {
     fn a_rug_on_the_floor_wins_over_the_floor() {
         use crate::scene::{Eye, Scene};
         let parts = Scene::tncg15_parts(Eye::One);
-        let mut shapes: Vec<Shape> = parts.prims.iter().map(|p| p.shape).collect();
+        let mut shapes: Vec<Shape> = parts.prims.iter().map(|p| p.shape.clone()).collect();
         let mut group: Vec<Option<u32>> = parts.prims.iter().map(|p| Some(p.material)).collect();
         let z = -5.0;
         for (a, b, c) in [((2.0, -2.0), (6.0, -2.0), (6.0, 2.0)), ((2.0, -2.0), (6.0, 2.0), (2.0, 2.0))] {

@@ -167,7 +167,7 @@ pub fn to_mitsuba(
         if let Some((_, m, mesh)) = run.take() {
             shapes += &out.mesh(mesh, &refs(m), "");
         }
-        shapes += &match p.shape {
+        shapes += &match &p.shape {
             Shape::Sphere(sphere) => format!(
                 "    <shape type=\"sphere\">\n        <point name=\"center\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{}\"/>\n{}    </shape>\n",
                 xyz(at(sphere.center)),
@@ -179,7 +179,7 @@ pub fn to_mitsuba(
                 disk_transform(at(d.center), d.normal, d.radius * s),
                 refs(p.material)
             ),
-            Shape::Ellipsoid(e) => out.ellipsoid(&e, &refs(p.material)),
+            Shape::Ellipsoid(e) => out.ellipsoid(e, &refs(p.material)),
             Shape::Cylinder(c) => format!(
                 "    <shape type=\"cylinder\">\n        <point name=\"p0\" value=\"{}\"/>\n        <point name=\"p1\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{}\"/>\n        <boolean name=\"flip_normals\" value=\"{}\"/>\n{}    </shape>\n",
                 xyz(at(c.p0)),
@@ -188,7 +188,25 @@ pub fn to_mitsuba(
                 c.flip,
                 refs(p.material)
             ),
+            Shape::Ellipse(e) => {
+                let to_world = crate::shape::ellipse_to_world(e);
+                let placed = glam::DAffine3::from_scale(glam::DVec3::splat(s as f64))
+                    * glam::DAffine3::from_translation(-placement.origin.as_dvec3())
+                    * to_world;
+                let m = Affine3A::from_mat3_translation(placed.matrix3.as_mat3(), placed.translation.as_vec3());
+                format!("    <shape type=\"disk\">\n        {}\n{}    </shape>\n", matrix(&m), refs(p.material))
+            }
             Shape::Triangle(_) => unreachable!("handled above"),
+            // A shape added to photonmap renders before the export knows
+            // it: until an arm here writes it, exporting it is refused
+            // with its place.
+            #[allow(unreachable_patterns)]
+            shape => {
+                return Err(refuse(
+                    place(&|o| o.objects.get(p.object as usize)),
+                    format!("the {} has no equivalent in the Mitsuba export yet", shape.name()),
+                ))
+            }
         };
     }
     if let Some((_, m, mesh)) = run.take() {
@@ -344,18 +362,23 @@ impl Exporter<'_> {
         let s = cols[0].length();
         let even = cols.iter().all(|c| (c.length() - s).abs() <= 1e-5 * s)
             && (cols[0].dot(cols[1]).abs() + cols[1].dot(cols[2]).abs() + cols[0].dot(cols[2]).abs()) <= 1e-5 * s * s;
+        let flip = if e.is_flipped() { "        <boolean name=\"flip_normals\" value=\"true\"/>\n" } else { "" };
         if even {
             return format!(
-                "    <shape type=\"sphere\">\n        <point name=\"center\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{s}\"/>\n{refs}    </shape>\n",
+                "    <shape type=\"sphere\">\n        <point name=\"center\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{s}\"/>\n{flip}{refs}    </shape>\n",
                 xyz(Vec3::from(m.translation))
             );
         }
         let normal_map = m.matrix3.inverse().transpose();
         let sphere = icosphere(5);
         let mut mesh = PlyMesh::new(true);
+        let sign = if e.is_flipped() { -1.0 } else { 1.0 };
         for f in &sphere.faces {
+            // Flipped: wound the other way, normals inwards.
+            let f = if e.is_flipped() { [f[0], f[2], f[1]] } else { *f };
             let p = f.map(|i| m.transform_point3(sphere.positions[i as usize]));
-            let n = f.map(|i| Vec3::from(normal_map * glam::Vec3A::from(sphere.normals[i as usize])).normalize());
+            let n =
+                f.map(|i| sign * Vec3::from(normal_map * glam::Vec3A::from(sphere.normals[i as usize])).normalize());
             mesh.push(p, n);
         }
         self.notes.push(format!(

@@ -16,16 +16,17 @@ pub mod ply;
 pub mod procedural;
 mod room;
 pub mod serialized;
+pub mod vol;
 
 pub use room::{tncg15_room, Eye};
 
-use crate::shape::{Cylinder, Departure, Disk, Ellipsoid, Shape, ShapeHit, Sphere, Triangle};
+use crate::shape::{Departure, Disk, Shape, ShapeHit, Triangle};
 use glam::{Vec2, Vec3};
 
 /// One primitive: its geometry, the index of its material, and the object
 /// it belongs to (a mesh, a sphere, the room: what a scene file lists as
 /// one shape).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Prim {
     pub shape: Shape,
     pub material: u32,
@@ -339,17 +340,7 @@ impl SceneParts {
         let scale_triangle = |t: Triangle| Triangle::new(t.v0 * s, t.v1 * s, t.v2 * s);
         let scale_disk = |d: Disk| Disk { center: d.center * s, radius: d.radius * s, ..d };
         for p in &mut self.prims {
-            p.shape = match p.shape {
-                Shape::Triangle(t) => Shape::Triangle(scale_triangle(t)),
-                Shape::Sphere(sp) => Shape::Sphere(Sphere { center: sp.center * s, radius: sp.radius * s }),
-                Shape::Disk(d) => Shape::Disk(scale_disk(d)),
-                Shape::Ellipsoid(e) => Shape::Ellipsoid(
-                    Ellipsoid::new(glam::Affine3A::from_scale(Vec3::splat(s)) * e.to_world()).unwrap_or(e),
-                ),
-                Shape::Cylinder(c) => {
-                    Shape::Cylinder(Cylinder { p0: c.p0 * s, length: c.length * s, radius: c.radius * s, ..c })
-                }
-            };
+            p.shape = p.shape.scaled(s);
         }
         for l in &mut self.lights {
             match l {
@@ -613,7 +604,7 @@ impl Scene {
     #[inline]
     fn shading_normal(&self, h: &ShapeHit) -> Vec3 {
         let Some(&codes) = self.shading_normals.get(h.shading as usize) else {
-            return h.normal;
+            return h.shading_normal.unwrap_or(h.normal);
         };
         let [n0, n1, n2] = codes.map(crate::math::decode_unit);
         let [u, v] = h.uv;

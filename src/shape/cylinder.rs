@@ -109,7 +109,7 @@ impl Cylinder {
         // ulp of its terms; the bound covers that and the final rounding.
         let p_err = gamma(2) * (point.abs() + self.p0.abs() + on_surface.abs().as_vec3());
         let normal = if self.flip { -out } else { out };
-        ShapeHit { t, point, p_err, normal: normal.as_vec3(), uv: [0.0; 2], shading: FLAT }
+        ShapeHit { t, point, p_err, normal: normal.as_vec3(), uv: [0.0; 2], shading: FLAT, shading_normal: None }
     }
 
     /// Axis-aligned bounds: the two end circles' boxes.

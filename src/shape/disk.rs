@@ -39,7 +39,7 @@ impl Disk {
         let local = local - self.normal * local.dot(self.normal);
         let point = self.center + local;
         let p_err = gamma(6) * (local.abs() + self.center.abs() + point.abs());
-        ShapeHit { t, point, p_err, normal: self.normal, uv: [0.0; 2], shading: FLAT }
+        ShapeHit { t, point, p_err, normal: self.normal, uv: [0.0; 2], shading: FLAT, shading_normal: None }
     }
 
     pub fn area(&self) -> f32 {

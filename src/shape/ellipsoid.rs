@@ -16,6 +16,8 @@ use glam::{Affine3, Affine3A, Vec3};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ellipsoid {
     to_object: Affine3,
+    /// The normal points inwards (Mitsuba's `flip_normals`).
+    flip: bool,
 }
 
 impl Ellipsoid {
@@ -27,7 +29,23 @@ impl Ellipsoid {
         }
         let to_object = to_world.inverse();
         let to_object = Affine3::from_mat3_translation(to_object.matrix3.into(), to_object.translation.into());
-        (to_object.is_finite() && to_object.inverse().is_finite()).then_some(Ellipsoid { to_object })
+        (to_object.is_finite() && to_object.inverse().is_finite()).then_some(Ellipsoid { to_object, flip: false })
+    }
+
+    /// The same surface with its normal pointing inwards.
+    pub fn flipped(self) -> Self {
+        Ellipsoid { flip: !self.flip, ..self }
+    }
+
+    /// Whether the normal points inwards.
+    pub fn is_flipped(&self) -> bool {
+        self.flip
+    }
+
+    /// The ellipsoid with every length times `s` about the origin.
+    pub fn scaled(&self, s: f32) -> Self {
+        Ellipsoid::new(Affine3A::from_scale(Vec3::splat(s)) * self.to_world())
+            .map_or(*self, |e| Ellipsoid { flip: self.flip, ..e })
     }
 
     /// The map from the unit sphere to the shape.
@@ -52,6 +70,8 @@ impl Ellipsoid {
     pub fn distance(&self, ray: &Ray, t_max: f32, departed: Option<bool>) -> Option<f32> {
         let (local, len) = self.object_ray(ray)?;
         let unit = Sphere { center: Vec3::ZERO, radius: 1.0 };
+        // Leaving along a flipped normal is leaving the unit sphere inwards.
+        let departed = departed.map(|along| along != self.flip);
         // The affine map keeps a line's parameter; only the unit-length
         // normalisation in object space rescales it.
         unit.distance(&local, t_max * len, departed).map(|t| t / len)
@@ -70,7 +90,8 @@ impl Ellipsoid {
         let p_err = Vec3::from(abs_m * glam::Vec3A::from(unit.p_err + gamma(4) * local.abs()))
             + gamma(4) * (Vec3::from(abs_m * glam::Vec3A::from(local.abs())) + Vec3::from(to_world.translation.abs()));
         let normal = (self.to_object.matrix3.transpose() * local).normalize();
-        ShapeHit { t, point, p_err, normal, uv: [0.0; 2], shading: FLAT }
+        let normal = if self.flip { -normal } else { normal };
+        ShapeHit { t, point, p_err, normal, uv: [0.0; 2], shading: FLAT, shading_normal: None }
     }
 
     pub fn bounds(&self) -> (Vec3, Vec3) {

@@ -1,6 +1,13 @@
 //! The course's shapes: triangles (Möller–Trumbore), spheres (analytic, both
-//! roots), disks, and tetrahedra as four triangles; ellipsoids and Mitsuba's
-//! open cylinders.
+//! roots), disks, and tetrahedra as four triangles; ellipsoids, ellipses,
+//! Mitsuba's open cylinders and its signed-distance grids.
+//!
+//! A shape is a closed set: [`Shape`]'s variants, each a file here whose
+//! type answers the same few questions (where a ray meets it, the hit's
+//! record, its bounds, the scene scaled). Adding one touches its file,
+//! its arms in `Shape`'s methods below and the front-end that reads it;
+//! nothing past the accelerator matches on shapes, and the Mitsuba export
+//! refuses a shape it does not know with its place.
 //!
 //! Every intersection returns the hit point together with a bound on its
 //! rounding error, which [`crate::math::offset_ray_origin`] turns into a safe
@@ -13,18 +20,23 @@
 
 mod cylinder;
 mod disk;
+mod ellipse;
 mod ellipsoid;
+mod sdf_grid;
 mod sphere;
 mod triangle;
 
 pub use cylinder::Cylinder;
 pub use disk::Disk;
+pub use ellipse::{ellipse_to_world, Ellipse};
 pub use ellipsoid::Ellipsoid;
+pub use sdf_grid::{Normals, SdfGrid};
 pub use sphere::Sphere;
 pub use triangle::{tetrahedron, RayShear, Triangle, FLAT};
 
 use crate::math::{Ray, Vertex};
 use glam::Vec3;
+use std::sync::Arc;
 
 /// Where a ray started: the primitive it left and whether it left along the
 /// primitive's geometric normal (`outward`) or against it.
@@ -48,16 +60,23 @@ pub struct ShapeHit {
     pub uv: [f32; 2],
     /// The triangle's vertex normals ([`Triangle::shading`]), or [`FLAT`].
     pub shading: u32,
+    /// A shading normal the shape computes itself (on the geometric
+    /// normal's side, unit), where it has one: a signed-distance grid's
+    /// smooth normals.
+    pub shading_normal: Option<Vec3>,
 }
 
-/// The geometry of one primitive.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The geometry of one primitive. Not `Copy`: a grid's samples are shared
+/// by reference.
+#[derive(Clone, Debug, PartialEq)]
 pub enum Shape {
     Triangle(Triangle),
     Sphere(Sphere),
     Disk(Disk),
     Ellipsoid(Ellipsoid),
     Cylinder(Cylinder),
+    Ellipse(Ellipse),
+    SdfGrid(Arc<SdfGrid>),
 }
 
 impl Shape {
@@ -81,7 +100,7 @@ impl Shape {
     ) -> Option<(f32, [f32; 2])> {
         match self {
             // A ray never meets the plane it leaves again.
-            Shape::Triangle(_) | Shape::Disk(_) if departed.is_some() => None,
+            Shape::Triangle(_) | Shape::Disk(_) | Shape::Ellipse(_) if departed.is_some() => None,
             Shape::Triangle(tri) => {
                 tri.distance(ray, rs.get_or_init(|| RayShear::new(ray)), t_max).map(|(t, u, v)| (t, [u, v]))
             }
@@ -89,6 +108,8 @@ impl Shape {
             Shape::Sphere(s) => s.distance(ray, t_max, departed).map(|t| (t, [0.0; 2])),
             Shape::Ellipsoid(e) => e.distance(ray, t_max, departed).map(|t| (t, [0.0; 2])),
             Shape::Cylinder(c) => c.distance(ray, t_max, departed).map(|t| (t, [0.0; 2])),
+            Shape::Ellipse(e) => e.distance(ray, t_max).map(|t| (t, [0.0; 2])),
+            Shape::SdfGrid(g) => g.distance(ray, t_max, departed).map(|t| (t, [0.0; 2])),
         }
     }
 
@@ -100,6 +121,8 @@ impl Shape {
             Shape::Sphere(s) => s.record(ray, t),
             Shape::Ellipsoid(e) => e.record(ray, t),
             Shape::Cylinder(c) => c.record(ray, t),
+            Shape::Ellipse(e) => e.record(ray, t),
+            Shape::SdfGrid(g) => g.record(ray, t),
         }
     }
 
@@ -118,6 +141,8 @@ impl Shape {
                 (Vec3::from(e.to_world().translation), ((hi - lo) * 0.5).length())
             }
             Shape::Cylinder(c) => c.bounding_sphere(),
+            Shape::Ellipse(e) => e.bounding_sphere(),
+            Shape::SdfGrid(g) => g.bounding_sphere(),
         }
     }
 
@@ -137,6 +162,8 @@ impl Shape {
                 (e.to_world().matrix3.transpose() * glam::Vec3A::from(u)).length(),
             ),
             Shape::Cylinder(c) => return c.extent_along(u),
+            Shape::Ellipse(e) => return e.extent_along(u),
+            Shape::SdfGrid(g) => return g.extent_along(u),
         };
         (c - half, c + half)
     }
@@ -153,6 +180,38 @@ impl Shape {
             }
             Shape::Ellipsoid(e) => e.bounds(),
             Shape::Cylinder(c) => c.bounds(),
+            Shape::Ellipse(e) => e.bounds(),
+            Shape::SdfGrid(g) => g.bounds(),
+        }
+    }
+
+    /// The shape with every length multiplied by `s` (> 0) about the origin.
+    pub fn scaled(&self, s: f32) -> Shape {
+        match self {
+            Shape::Triangle(t) => {
+                Shape::Triangle(Triangle { shading: t.shading, ..Triangle::new(t.v0 * s, t.v1 * s, t.v2 * s) })
+            }
+            Shape::Sphere(sp) => Shape::Sphere(Sphere { center: sp.center * s, radius: sp.radius * s }),
+            Shape::Disk(d) => Shape::Disk(Disk { center: d.center * s, radius: d.radius * s, ..*d }),
+            Shape::Ellipsoid(e) => Shape::Ellipsoid(e.scaled(s)),
+            Shape::Cylinder(c) => {
+                Shape::Cylinder(Cylinder { p0: c.p0 * s, length: c.length * s, radius: c.radius * s, ..*c })
+            }
+            Shape::Ellipse(e) => Shape::Ellipse(e.scaled(s)),
+            Shape::SdfGrid(g) => Shape::SdfGrid(Arc::new(g.scaled(s))),
+        }
+    }
+
+    /// What the shape is called in messages (an export's refusal).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Shape::Triangle(_) => "triangle",
+            Shape::Sphere(_) => "sphere",
+            Shape::Disk(_) => "disk",
+            Shape::Ellipsoid(_) => "ellipsoid",
+            Shape::Cylinder(_) => "cylinder",
+            Shape::Ellipse(_) => "ellipse",
+            Shape::SdfGrid(_) => "signed-distance grid",
         }
     }
 }

@@ -69,7 +69,7 @@ impl Sphere {
         let local = local * (self.radius / len);
         let point = self.center + local;
         let p_err = gamma(5) * local.abs() + gamma(2) * point.abs();
-        ShapeHit { t, point, p_err, normal: local / self.radius, uv: [0.0; 2], shading: FLAT }
+        ShapeHit { t, point, p_err, normal: local / self.radius, uv: [0.0; 2], shading: FLAT, shading_normal: None }
     }
 }
 

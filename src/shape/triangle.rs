@@ -183,7 +183,7 @@ impl Triangle {
         let w = 1.0 - u - v;
         let point = w * self.v0 + u * self.v1 + v * self.v2;
         let p_err = gamma(7) * ((w * self.v0).abs() + (u * self.v1).abs() + (v * self.v2).abs());
-        ShapeHit { t, point, p_err, normal: self.normal, uv: [u, v], shading: self.shading }
+        ShapeHit { t, point, p_err, normal: self.normal, uv: [u, v], shading: self.shading, shading_normal: None }
     }
 }
 

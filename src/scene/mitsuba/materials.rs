@@ -35,6 +35,7 @@ impl Builder<'_> {
             },
         };
         let m = self.materials.len() as u32;
+        self.origins.materials.push(bsdf.map(super::place).unwrap_or_default());
         self.materials.push(material);
         self.textured.push(textured);
         self.perturb.push(perturb);

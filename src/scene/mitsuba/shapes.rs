@@ -2,9 +2,11 @@
 //! instance's), with its BSDF and, for an area emitter, a light per
 //! triangle. Mitsuba's shapes in their own frames (src/shapes/*.cpp):
 //! `rectangle` is [-1, 1]^2 at z = 0 facing +z, `cube` is [-1, 1]^3,
-//! `disk` the unit disk facing +z, `sphere` a `center` and `radius`,
+//! `disk` the unit disk facing +z (an ellipse under an uneven scale),
+//! `sphere` a `center` and `radius` (an ellipsoid under an uneven scale),
 //! `cylinder` an open tube of `radius` from `p0` to `p1`, its normals away
-//! from the axis.
+//! from the axis, `sdfgrid` a signed distance grid over [0, 1]^3 read from
+//! a `.vol` file (crate::shape::SdfGrid).
 //!
 //! Meshes keep their vertex normals; a mesh without them gets
 //! angle-weighted vertex normals (Thürmer and Wüthrich 1998), as Mitsuba
@@ -21,7 +23,7 @@ use crate::scene::mesh::load_obj;
 use crate::scene::ply::load_ply;
 use crate::scene::serialized::load_serialized;
 use crate::scene::{LightSpec, Prim};
-use crate::shape::{Cylinder, Disk, Ellipsoid, Shape, Sphere, Triangle};
+use crate::shape::{Cylinder, Disk, Ellipse, Ellipsoid, Normals, SdfGrid, Shape, Sphere, Triangle};
 use crate::texture::SurfaceUv;
 use glam::{Affine3A, DAffine3, DVec3, Vec2, Vec3};
 use std::collections::HashMap;
@@ -104,6 +106,8 @@ impl Builder<'_> {
             return Err(p.fail(p.loc(), "to_world", "the transform is singular"));
         }
         let object = self.new_object();
+        self.origins.objects.resize(object as usize, super::place(p));
+        self.origins.objects.push(super::place(p));
         let mut uv = None;
         let mesh = match p.kind {
             "obj" | "ply" | "serialized" => {
@@ -177,17 +181,16 @@ impl Builder<'_> {
             "sphere" => {
                 let center = p.point("center")?.unwrap_or(DVec3::ZERO);
                 let radius = p.float_in("radius", 1.0, 0.0, 1e15)?;
-                if flip {
-                    return Err(p.fail(p.loc(), "flip_normals", "a sphere with inward normals is not supported yet"));
-                }
                 let m = to_world * DAffine3::from_translation(center) * DAffine3::from_scale(DVec3::splat(radius));
                 self.frames.push(affine(&m.inverse()));
                 uv = Some(SurfaceUv::Sphere(self.frames.len() as u32 - 1));
+                let ellipsoid =
+                    || Ellipsoid::new(affine(&m)).ok_or_else(|| p.fail(p.loc(), "to_world", "the transform is singular"));
                 Mesh::Analytic(match similarity(&m) {
-                    Some(s) => Shape::Sphere(Sphere { center: m.translation.as_vec3(), radius: s as f32 }),
-                    None => Shape::Ellipsoid(
-                        Ellipsoid::new(affine(&m)).ok_or_else(|| p.fail(p.loc(), "to_world", "the transform is singular"))?,
-                    ),
+                    Some(s) if !flip => Shape::Sphere(Sphere { center: m.translation.as_vec3(), radius: s as f32 }),
+                    // Inward normals: the ellipsoid holds the flag.
+                    _ if flip => Shape::Ellipsoid(ellipsoid()?.flipped()),
+                    _ => Shape::Ellipsoid(ellipsoid()?),
                 })
             }
             "cylinder" => {
@@ -216,24 +219,49 @@ impl Builder<'_> {
                 Mesh::Analytic(Shape::Cylinder(c))
             }
             "disk" => {
-                if flip {
-                    return Err(p.fail(p.loc(), "flip_normals", "a disk with flipped normals is not supported yet"));
-                }
-                let s = similarity(&to_world).ok_or_else(|| {
-                    p.fail(p.loc(), "to_world", "a disk stretched into an ellipse is not supported (scale it uniformly)")
-                })?;
-                let normal = to_world.matrix3.z_axis.normalize().as_vec3();
                 self.frames.push(affine(&to_world.inverse()));
                 uv = Some(SurfaceUv::Disk(self.frames.len() as u32 - 1));
-                Mesh::Analytic(Shape::Disk(Disk { center: to_world.translation.as_vec3(), normal, radius: s as f32 }))
+                // Mitsuba's normal is to_world's image of +z as a normal.
+                let normal = (to_world.matrix3.inverse().transpose() * DVec3::Z).normalize().as_vec3();
+                let normal = if flip { -normal } else { normal };
+                Mesh::Analytic(match similarity(&to_world) {
+                    Some(s) => Shape::Disk(Disk { center: to_world.translation.as_vec3(), normal, radius: s as f32 }),
+                    None => {
+                        let e = Ellipse::new(&to_world)
+                            .ok_or_else(|| p.fail(p.loc(), "to_world", "the transform is singular"))?;
+                        Shape::Ellipse(if flip { e.flipped() } else { e })
+                    }
+                })
+            }
+            "sdfgrid" => {
+                let (name, loc) = p.string("filename")?.ok_or_else(|| p.refuse("an sdfgrid needs a filename"))?;
+                let normals = match p.string("normals")? {
+                    None => Normals::Smooth,
+                    Some((n, _)) if n == "smooth" => Normals::Smooth,
+                    Some((n, _)) if n == "analytic" => Normals::Analytic,
+                    Some((n, at)) => return Err(p.fail(&at, "normals", format!("'{n}' (smooth or analytic)"))),
+                };
+                if flip {
+                    return Err(p.fail(p.loc(), "flip_normals", "is not a parameter of Mitsuba's sdfgrid"));
+                }
+                if emitter.is_some() {
+                    return Err(p.refuse("an sdfgrid cannot be an area emitter (as in Mitsuba)"));
+                }
+                let path = self.resolve(&name, &loc)?;
+                let vol = crate::scene::vol::load_vol(&path).map_err(|e| p.fail(&loc, "filename", e))?;
+                if vol.channels != 1 {
+                    return Err(p.fail(&loc, "filename", format!("the grid has {} channels, an sdfgrid 1", vol.channels)));
+                }
+                let grid = SdfGrid::new(vol.size, vol.data, to_world, normals).map_err(|e| p.fail(&loc, "filename", e))?;
+                Mesh::Analytic(Shape::SdfGrid(std::sync::Arc::new(grid)))
             }
             k => {
                 return Err(p.refuse(format!(
-                    "the '{k}' shape is not supported yet (obj, ply, serialized, rectangle, cube, sphere, cylinder, disk, shapegroup, instance are)"
+                    "the '{k}' shape is not supported yet (obj, ply, serialized, rectangle, cube, sphere, cylinder, disk, sdfgrid, shapegroup, instance are)"
                 )))
             }
         };
-        p.finish("filename, shape_index, face_normals, flip_normals, flip_tex_coords, to_world, center, radius, p0, p1, bsdf, emitter")?;
+        p.finish("filename, shape_index, face_normals, flip_normals, flip_tex_coords, to_world, center, radius, p0, p1, normals, bsdf, emitter")?;
         match mesh {
             Mesh::Analytic(shape) => match (radiance, shape) {
                 (None, shape) => {
@@ -246,6 +274,7 @@ impl Builder<'_> {
                     ))
                 }
                 (Some(radiance), Shape::Disk(d)) => {
+                    self.origins.lights.push(super::place(p));
                     self.lights.push(LightSpec::Area { surface: Emitting::Disk(d), radiance, material: Some(material) })
                 }
                 (Some(_), _) => {
@@ -255,7 +284,10 @@ impl Builder<'_> {
                     )))
                 }
             },
-            Mesh::Tris(t) => self.push_triangles(t, &to_world, flip, material, object, radiance.map(|r| (r, image))),
+            Mesh::Tris(t) => {
+                let emits = radiance.map(|r| (r, image, super::place(p)));
+                self.push_triangles(t, &to_world, flip, material, object, emits)
+            }
         }
         Ok(())
     }
@@ -267,7 +299,7 @@ impl Builder<'_> {
         flip: bool,
         material: u32,
         object: u32,
-        emits: Option<(Color, Option<std::sync::Arc<crate::texture::Texture>>)>,
+        emits: Option<(Color, Option<std::sync::Arc<crate::texture::Texture>>, crate::scene::file::Place)>,
     ) {
         let normal_map = to_world.matrix3.inverse().transpose();
         // A mirroring transform and flip_normals each turn the surface over.
@@ -294,7 +326,8 @@ impl Builder<'_> {
             if !(t.area() > 0.0) {
                 continue;
             }
-            if let Some((radiance, image)) = &emits {
+            if let Some((radiance, image, place)) = &emits {
+                self.origins.lights.push(place.clone());
                 let radiance = *radiance;
                 if let Some(texture) = image {
                     let pattern = crate::light::AreaPattern { texture: (**texture).clone(), uv };
