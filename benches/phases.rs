@@ -150,7 +150,7 @@ fn skips(c: &mut Criterion) {
     let glass_only = Scene::from_parts(photonmap::scene::file::load(&path).unwrap().parts);
     let points = glass_only.diffuse_hits(64, 48);
     let photons = trace_pass(&glass_only, Pass::Caustic, 200_000, 1, &|_| {}).photons;
-    let r = Settings::default().r_caustic(&glass_only);
+    let r = Settings::default().r_caustic(glass_only.diagonal());
     for skip in [true, false] {
         let map = PhotonMap::build_with_grid(photons.clone(), Some(r));
         let map = if skip { map } else { map.without_grid() };

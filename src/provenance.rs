@@ -3,7 +3,7 @@
 //! every EXR's header, and into partial renders' manifests, where it
 //! decides which partials may be added together.
 
-use crate::settings::{Method, Settings};
+use crate::settings::Settings;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
@@ -60,13 +60,6 @@ pub fn settings_key(settings: &Settings) -> String {
     format!("{settings:?}")
 }
 
-pub fn method_name(method: Method) -> &'static str {
-    match method {
-        Method::Photon => "photon",
-        Method::Path => "path",
-    }
-}
-
 /// How an image was made, for an EXR's header.
 pub struct Provenance<'a> {
     pub scene: &'a SceneId,
@@ -85,7 +78,7 @@ impl Provenance<'_> {
         [
             ("scene", self.scene.name.clone()),
             ("scene_sha256", self.scene.hash.clone()),
-            ("integrator", method_name(s.method).to_string()),
+            ("integrator", s.method.name().to_string()),
             ("seed", s.seed.to_string()),
             ("photons_per_pass", format!("{} global, {} caustic", s.photons, s.caustic_photons)),
             ("photons_emitted", self.photons.to_string()),

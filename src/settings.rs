@@ -1,17 +1,7 @@
 //! Every setting that decides a render, with its default: the command
 //! lines take their defaults from here.
 
-use crate::scene::Scene;
-
-/// The estimator a render uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Method {
-    /// Photon mapping: direct light, caustic map, final gathering.
-    #[default]
-    Photon,
-    /// Path tracing with next-event estimation (unbiased, the reference).
-    Path,
-}
+pub use crate::render::Method;
 
 /// Everything that decides the image besides the scene.
 #[derive(Clone, Copy, Debug)]
@@ -110,12 +100,14 @@ pub const GLOBAL_RADIUS_FRACTION: f32 = 0.05;
 pub const CAUSTIC_RADIUS_FRACTION: f32 = 0.01;
 
 impl Settings {
-    pub fn r_global(&self, scene: &Scene) -> f32 {
-        self.r_global.unwrap_or(GLOBAL_RADIUS_FRACTION * scene.diagonal())
+    /// The global map's radius cap in a scene of this diagonal.
+    pub fn r_global(&self, diagonal: f32) -> f32 {
+        self.r_global.unwrap_or(GLOBAL_RADIUS_FRACTION * diagonal)
     }
 
-    pub fn r_caustic(&self, scene: &Scene) -> f32 {
-        self.r_caustic.unwrap_or(CAUSTIC_RADIUS_FRACTION * scene.diagonal())
+    /// The caustic map's radius cap in a scene of this diagonal.
+    pub fn r_caustic(&self, diagonal: f32) -> f32 {
+        self.r_caustic.unwrap_or(CAUSTIC_RADIUS_FRACTION * diagonal)
     }
 }
 

@@ -1,10 +1,8 @@
 //! What a render did and what it cost: the counters each thread keeps while
-//! it shades ([`Counters`]), the render's totals and times ([`Stats`]), and
-//! the summary printed at the end ([`Summary`]). A new statistic is a field
-//! here and a line of the summary.
+//! it shades ([`Counters`]) and the render's totals and times ([`Stats`]).
+//! A new statistic is a field here and a line of the summary
+//! (`render::summary`, or its method's part of it).
 
-use crate::settings::{Method, Settings};
-use std::path::PathBuf;
 use std::time::Duration;
 
 /// What a thread counted while it shaded; summed over threads by [`merge`](Counters::merge).
@@ -130,132 +128,6 @@ impl Stats {
         self.k_caustic = o.k_caustic;
         self.skipped_global = o.skipped_global;
         self.skipped_caustic = o.skipped_caustic;
-    }
-}
-
-/// The summary a program prints at the end of a render: every line within
-/// 100 columns.
-pub struct Summary<'a> {
-    pub stats: &'a Stats,
-    pub settings: &'a Settings,
-    pub threads: usize,
-    /// Reading the scene file and building the scene (its BVH).
-    pub load_time: Duration,
-    pub write_time: Duration,
-    pub total_time: Duration,
-    pub written: &'a [PathBuf],
-}
-
-impl Summary<'_> {
-    pub fn lines(&self) -> Vec<String> {
-        let s = self.stats;
-        let st = self.settings;
-        let secs = |d: Duration| d.as_secs_f64();
-        let per_s = |n: u64, d: Duration| n as f64 / secs(d).max(1e-9) / 1e6;
-        let pct = |a: u64, b: u64| 100.0 * a as f64 / b.max(1) as f64;
-        let method = match st.method {
-            Method::Photon => "photon mapping",
-            Method::Path => "path tracing",
-        };
-        let (passes, threads) =
-            (counted(s.passes as u64, "pass", "passes"), counted(self.threads as u64, "thread", "threads"));
-        let mut out = vec![format!("photonmap: {method}, {passes}, {threads}, {} x {}", st.width, st.height)];
-        out.push(format!("  scene load   {:>8.3} s", secs(self.load_time)));
-        if st.method == Method::Photon {
-            let last = if s.passes > 1 { " (last pass)" } else { "" };
-            out.push(format!(
-                "  global map   {:>11} emitted {:>11} stored{last}; {:.1}% first hit mirror/glass",
-                s.global_emitted,
-                s.global_stored,
-                pct(s.global_specular_hits, s.global_emitted)
-            ));
-            out.push(format!(
-                "  caustic map  {:>11} emitted {:>11} stored; {:.1}% aimed hit mirror/glass",
-                s.caustic_emitted,
-                s.caustic_stored,
-                pct(s.caustic_aimed_hits, s.caustic_emitted)
-            ));
-            if s.caustic_targets.len() > 1 {
-                for (k, &(object, aimed, hit)) in s.caustic_targets.iter().enumerate().take(8) {
-                    out.push(format!(
-                        "               target {k} (shape {object}): {:.1}% of {aimed} aimed hit mirror/glass",
-                        pct(hit, aimed)
-                    ));
-                }
-                if s.caustic_targets.len() > 8 {
-                    out.push(format!("               ... and {} more targets", s.caustic_targets.len() - 8));
-                }
-            }
-            out.push(format!(
-                "               {:.1} MB of maps, {} cache points; radius caps {:.3} global, {:.3} caustic",
-                s.map_bytes as f64 / 1e6,
-                s.cache_points,
-                s.r_global,
-                s.r_caustic
-            ));
-            if s.spots > 0 {
-                let plural = if s.spots == 1 { "" } else { "s" };
-                out.push(format!("               {} bright spot{plural} for final gathering to aim at", s.spots));
-            }
-            out.push(format!(
-                "  photon pass  {:>8.3} s  {:>7.2} M photons/s  {:>7.2} M rays/s",
-                secs(s.photon_time),
-                per_s(s.global_emitted + s.caustic_emitted, s.photon_time),
-                per_s(s.photon_rays, s.photon_time)
-            ));
-            out.push(format!(
-                "  map build    {:>8.3} s  (maps {:.3} s, irradiance cache {:.3} s)",
-                secs(s.build_time()),
-                secs(s.tree_time),
-                secs(s.cache_time)
-            ));
-        }
-        let gather = match (st.method, st.aimed_rays()) {
-            (Method::Photon, 0) => format!(", {} gather", st.gather_rays),
-            (Method::Photon, aimed) => format!(", {} gather ({aimed} aimed)", st.gather_rays),
-            _ => String::new(),
-        };
-        out.push(format!(
-            "  camera pass  {:>8.3} s  {:>7.2} M rays/s  ({} spp{gather}, {} shadow rays)",
-            secs(s.camera_time),
-            per_s(s.camera.rays, s.camera_time),
-            st.spp,
-            st.shadow_rays
-        ));
-        if s.edge_pixels > 0 {
-            out.push(format!(
-                "               {} pixels on a light's rim took {} extra samples",
-                s.edge_pixels, st.edge_spp
-            ));
-        }
-        let c = &s.camera;
-        if c.caustic_estimates + c.caustic_reused > 0 {
-            out.push(format!(
-                "               {} caustic estimates, {} reused within a pixel ({:.0}%)",
-                c.caustic_estimates,
-                c.caustic_reused,
-                pct(c.caustic_reused, c.caustic_estimates + c.caustic_reused)
-            ));
-        }
-        let mut skipped = Vec::new();
-        if s.skipped_global {
-            skipped.push("the global map (nothing diffuse reflects light)".to_string());
-        }
-        if s.skipped_caustic {
-            skipped.push("the caustic map (no mirror or glass, or nothing diffuse)".to_string());
-        }
-        if c.shadow_rays_skipped > 0 {
-            skipped.push(format!("{} shadow rays to lights facing away", c.shadow_rays_skipped));
-        }
-        for (i, what) in skipped.iter().enumerate() {
-            out.push(format!("  {}  {what}", if i == 0 { "skipped:  " } else { "          " }));
-        }
-        out.push(format!("  write        {:>8.3} s", secs(self.write_time)));
-        for path in self.written {
-            out.push(format!("               {}", path.display()));
-        }
-        out.push(format!("  total        {:>8.3} s", secs(self.total_time)));
-        out
     }
 }
 

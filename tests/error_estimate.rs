@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 use photonmap::metrics::Window;
 use photonmap::render::accumulation::Accumulation;
 use photonmap::render::error_estimate::ErrorEstimate;
-use photonmap::render::progressive::bias_model;
+
 use photonmap::render::{render_passes, Budget, Stopped};
 use photonmap::scene::Scene;
 use photonmap::settings::{Method, Settings};
@@ -65,7 +65,8 @@ fn coverage(method: Method) -> (f64, f64) {
     let run = render_passes(&scene, &settings, Accumulation::new(40, 40), 0, &Budget::passes(16), |_| {
         ControlFlow::Continue(())
     });
-    let est = ErrorEstimate::new(&run.accumulation, bias_model(&settings)).expect("16 passes give an estimate");
+    let est = ErrorEstimate::new(&run.accumulation, settings.method.bias(settings.alpha))
+        .expect("16 passes give an estimate");
     // What the EXR's `error` layer holds.
     let stated = est.error_film();
     let (mut covered, mut total, mut z2) = (0, 0, 0.0);

@@ -153,7 +153,7 @@ fn a_pixels_samples_share_their_caustic_estimate() {
 fn caustic_lookups_where_the_map_is_empty_skip_the_tree() {
     let (scene, points) = glass_sun_and_floor_points();
     let photons = trace_pass(&scene, Pass::Caustic, 100_000, 1, &|_| {}).photons;
-    let r = Settings::default().r_caustic(&scene);
+    let r = Settings::default().r_caustic(scene.diagonal());
     let with = PhotonMap::build_with_grid(photons.clone(), Some(r));
     let without = PhotonMap::build_with_grid(photons, Some(r)).without_grid();
     let (mut a, mut b) = (Scratch::default(), Scratch::default());

@@ -3,11 +3,15 @@
 //! rho = m_a C A + sum_lights (m_l C I max(l.n, 0) + m_s S I max(r.v, 0)^m_sp) + m_r C traceRay(bounce).
 
 use glam::Vec3;
+use photonmap::film::Film;
 use photonmap::integrator::whitted::Whitted;
 use photonmap::math::{Color, Ray};
+use photonmap::render::render_with;
+use photonmap::render::tracers::WhittedTracing;
 use photonmap::sampling::{stream, Domain};
 use photonmap::scene::file::parse;
 use photonmap::scene::Scene;
+use photonmap::settings::Settings;
 use std::path::Path;
 
 const CAMERA: &str =
@@ -28,6 +32,12 @@ fn shade(scene: &Scene, depth: u32, origin: Vec3, towards: Vec3) -> Color {
     let whitted = Whitted { scene, max_depth: depth };
     let mut rng = stream(1, Domain::Camera, 0);
     whitted.trace_ray(&Ray::new(origin, (towards - origin).normalize()), None, 0, &mut rng)
+}
+
+/// The scene rendered by the Whitted tracer at 32 x 32, 16 samples a pixel.
+fn render(scene: &Scene, max_depth: u32) -> Film {
+    let settings = Settings { width: 32, height: 32, spp: 16, seed: 7, ..Settings::default() };
+    render_with(scene, &settings, &WhittedTracing { max_depth }, photonmap::progress::Mode::Quiet).0
 }
 
 fn close(got: Color, want: Color) {
@@ -137,14 +147,8 @@ fn jittered_supersampling_averages_an_edge() {
     // jittered rays its value lies strictly between black and the lit colour,
     // and the image is the same on 1 and 3 threads.
     let scene = sphere_scene(SUN);
-    let whitted = Whitted { scene: &scene, max_depth: 0 };
-    let run = |threads| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| whitted.render(32, 32, 16, 7, photonmap::progress::Mode::Quiet))
-    };
+    let run =
+        |threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| render(&scene, 0));
     let film = run(1);
     let partial = film.pixels.iter().filter(|c| c.x > 0.01 && c.x < 0.3).count();
     assert!(partial > 8, "{partial} pixels on the silhouette");
@@ -167,14 +171,9 @@ fn a_thin_lens_blurs_the_silhouette_on_any_thread_count() {
     };
     let (pinhole, lens) = (scene(""), scene("aperture_radius = 0.5\nfocus_distance = 40"));
     let run = |scene: &Scene, threads| {
-        let whitted = Whitted { scene, max_depth: 0 };
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| whitted.render(32, 32, 16, 7, photonmap::progress::Mode::Quiet))
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| render(scene, 0))
     };
-    let partial = |film: &photonmap::film::Film| film.pixels.iter().filter(|c| c.x > 0.01 && c.x < 0.3).count();
+    let partial = |film: &Film| film.pixels.iter().filter(|c| c.x > 0.01 && c.x < 0.3).count();
     let (sharp, blurred) = (run(&pinhole, 1), run(&lens, 1));
     assert!(partial(&blurred) > 2 * partial(&sharp), "{} vs {}", partial(&blurred), partial(&sharp));
     assert!(blurred.pixels == run(&lens, 3).pixels, "thread count changed the image");

@@ -5,13 +5,15 @@
 use clap::Parser;
 use photonmap::error::Error;
 use photonmap::film::ToneMap;
-use photonmap::integrator::whitted::Whitted;
 use photonmap::math::Color;
 use photonmap::memory::available_memory;
 use photonmap::output::{check_writable, same_file, write_with, Extras};
 use photonmap::progress::{Mode, Wait};
 use photonmap::provenance::SceneId;
+use photonmap::render::tracers::WhittedTracing;
+use photonmap::render::{render_with, Method};
 use photonmap::scene::Scene;
+use photonmap::settings::Settings;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -122,12 +124,15 @@ fn run(cli: Cli) -> Result<(), Error> {
         )));
     }
     let t = Instant::now();
-    let film = Whitted { scene: &scene, max_depth: cli.depth }.render(w, h, spp, cli.seed, Mode::detect(cli.quiet));
+    let settings =
+        Settings { method: Method::Whitted, width: w, height: h, spp, seed: cli.seed, ..Settings::default() };
+    let tracer = WhittedTracing { max_depth: cli.depth };
+    let (film, _) = render_with(&scene, &settings, &tracer, Mode::detect(cli.quiet));
     let render_time = t.elapsed();
     let attributes = [
         ("scene", id.name.clone()),
         ("scene_sha256", id.hash.clone()),
-        ("integrator", "whitted".to_string()),
+        ("integrator", Method::Whitted.name().to_string()),
         ("seed", cli.seed.to_string()),
         ("spp", spp.to_string()),
         ("depth", cli.depth.to_string()),

@@ -12,12 +12,9 @@
 //! Lambertian material of reflectance rho is read as m_l = 1 / pi, C = rho,
 //! m_a = 1: its direct light is then exactly photonmap's.
 
-use crate::film::Film;
 use crate::material::{Material, Phong, Transport};
 use crate::math::{max_component, Color, Frame, Ray};
 use crate::optics::reflect;
-use crate::progress::Mode;
-use crate::render::{camera_pass, CameraPass, Placement};
 use crate::sampling::{next_2d, stratified_2d, Rng};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;
@@ -116,21 +113,6 @@ impl Whitted<'_> {
             c += p.mirror * p.color * self.bounce(hit, ray, frame, depth, rng);
         }
         c
-    }
-
-    /// Renders the scene's camera at `width` x `height` on the shared
-    /// camera pass, each pixel the mean of `spp` jittered samples
-    /// (stratified when `spp` is a square: the course's n x n grid).
-    pub fn render(&self, width: u32, height: u32, spp: u32, seed: u64, progress: Mode) -> Film {
-        let pass = CameraPass {
-            camera: self.scene.camera.with_resolution(width, height),
-            spp,
-            edge_spp: 0,
-            seed,
-            pass: 0,
-            placement: Placement::JitteredGrid,
-        };
-        camera_pass(&pass, self, progress, &mut None).film
     }
 }
 

@@ -1,40 +1,50 @@
-//! The pipeline: scene → photon stage (photon passes, maps) → camera pass
-//! → film. A classic render is one pass; a progressive render averages
-//! passes whose estimates narrow ([`progressive`]).
+//! Rendering: a render method ([`method`]: photon mapping, path tracing,
+//! the Whitted tracer) renders passes (a photon stage where it has one,
+//! then the camera pass); a classic render is one pass, a progressive
+//! render averages passes whose estimates narrow ([`progressive`]).
 
 pub mod accumulation;
 pub mod camera_pass;
 pub mod error_estimate;
+pub mod method;
 pub mod photon_stage;
 pub mod progressive;
 mod rims;
+pub mod summary;
+pub mod tracers;
 
 pub use camera_pass::{camera_pass, CameraPass, Placement};
+pub use method::{Method, RenderMethod};
 pub use photon_stage::GLOBAL_GRID_CELL;
 pub use progressive::{render_passes, render_progressive, Budget, PassReport, Run, Stopped};
 
 use crate::film::Film;
-use crate::integrator::path::PathIntegrator;
 use crate::progress::Mode;
 use crate::scene::Scene;
-use crate::settings::{Method, Settings};
+use crate::settings::Settings;
 use crate::stats::Stats;
-use photon_stage::{photon_integrator, photon_pass, Estimates};
-use std::time::Instant;
 
 /// Renders `scene` (its camera at `settings`' resolution) in one pass.
 pub fn render(scene: &Scene, settings: &Settings, progress: Mode) -> (Film, Stats) {
-    render_pass(scene, settings, 0, progress, &mut None)
+    render_with(scene, settings, settings.method.unit(settings).as_ref(), progress)
+}
+
+/// Renders `scene` in one pass of `method` (a unit made otherwise than
+/// from `settings`: the Whitted tracer's depth).
+pub fn render_with(scene: &Scene, settings: &Settings, method: &dyn RenderMethod, progress: Mode) -> (Film, Stats) {
+    render_pass(scene, settings, method, 0, progress, &mut None)
 }
 
 /// Pass `pass` of a render: its own photons and camera samples, and (for
-/// photon mapping) the estimates of [`Estimates::progressive`], which for
-/// pass 0 are the classic ones. A one-pass render is pass 0. `rims`: the
-/// pixels on the rim of a light's image, found by the first pass that
-/// needs them and kept for the passes after it (see [`camera_pass`]).
+/// photon mapping) the estimates of
+/// [`photon_stage::Estimates::progressive`], which for pass 0 are the
+/// classic ones. A one-pass render is pass 0. `rims`: the pixels on the
+/// rim of a light's image, found by the first pass that needs them and
+/// kept for the passes after it (see [`camera_pass`]).
 pub(crate) fn render_pass(
     scene: &Scene,
     settings: &Settings,
+    method: &dyn RenderMethod,
     pass: u32,
     progress: Mode,
     rims: &mut Option<Vec<bool>>,
@@ -48,36 +58,15 @@ pub(crate) fn render_pass(
         pass: pass as u64,
         placement: Placement::Sobol,
     };
-    let t = Instant::now();
-    let shot = match settings.method {
-        Method::Photon => {
-            let est = Estimates::progressive(scene, settings, pass);
-            (stats.r_global, stats.r_caustic, stats.k_global, stats.k_caustic) =
-                (est.r_global, est.r_caustic, est.k_global, est.k_caustic);
-            let maps = photon_pass(scene, settings, pass as u64, est, progress, &mut stats);
-            let integrator = photon_integrator(scene, settings, &maps, est);
-            let t = Instant::now();
-            let shot = camera_pass(&camera, &integrator, progress, rims);
-            stats.camera_time = t.elapsed();
-            shot
-        }
-        Method::Path => {
-            let integrator =
-                PathIntegrator { scene, shadow_rays: settings.shadow_rays, skip: settings.skip, mis: true };
-            let shot = camera_pass(&camera, &integrator, progress, rims);
-            stats.camera_time = t.elapsed();
-            shot
-        }
-    };
-    stats.camera = shot.counters;
-    stats.edge_pixels = shot.edge_pixels;
-    (shot.film, stats)
+    let film = method.pass(scene, &camera, progress, rims, &mut stats);
+    (film, stats)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::scene::Eye;
+    use photon_stage::{photon_integrator, photon_pass, Estimates};
 
     /// The rim pixels are found by the first pass and used as they are by
     /// the passes after it (their probes are not cast again).
@@ -87,15 +76,18 @@ mod tests {
         let settings =
             Settings { photons: 5_000, caustic_photons: 5_000, width: 48, height: 48, spp: 1, ..Settings::default() };
         let mut rims = None;
-        let (_, first) = render_pass(&scene, &settings, 0, Mode::Quiet, &mut rims);
+        let unit = settings.method.unit(&settings);
+        let pass =
+            |pass, rims: &mut Option<Vec<bool>>| render_pass(&scene, &settings, unit.as_ref(), pass, Mode::Quiet, rims);
+        let (_, first) = pass(0, &mut rims);
         let found = rims.clone().expect("the first pass fills the rims");
         assert_eq!(first.edge_pixels, found.iter().filter(|&&r| r).count());
         assert!(first.edge_pixels > 0 && first.edge_pixels < 48 * 48 / 4, "{} rim pixels", first.edge_pixels);
-        let (_, second) = render_pass(&scene, &settings, 1, Mode::Quiet, &mut rims);
+        let (_, second) = pass(1, &mut rims);
         assert_eq!(rims.as_deref(), Some(&found[..]));
         assert_eq!(second.edge_pixels, first.edge_pixels);
         // Every pixel given as a rim takes the split estimate.
-        let (_, all) = render_pass(&scene, &settings, 1, Mode::Quiet, &mut Some(vec![true; 48 * 48]));
+        let (_, all) = pass(1, &mut Some(vec![true; 48 * 48]));
         assert_eq!(all.edge_pixels, 48 * 48);
         assert!(all.camera.rays > second.camera.rays + 48 * 48 * 100);
     }

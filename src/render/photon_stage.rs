@@ -1,7 +1,11 @@
-//! The photon stage of a pass: trace the global and caustic photons, build
-//! the caustic map and the global map's irradiance cache, and make the
-//! camera pass's estimator over them.
+//! Photon mapping as a render method: each pass's photon stage (trace the
+//! global and caustic photons, build the caustic map and the global map's
+//! irradiance cache), the camera pass's estimator over them, and its
+//! lines of the summary.
 
+use super::camera_pass::CameraPass;
+use super::method::{shoot, Method, MethodSummary, RenderMethod};
+use crate::film::Film;
 use crate::integrator::photon::{PhotonEstimator, PhotonIntegrator};
 use crate::integrator::{direct_irradiance, Context};
 use crate::photon::irradiance_cache::IrradianceCache;
@@ -13,7 +17,105 @@ use crate::sampling::{stream, Domain};
 use crate::scene::Scene;
 use crate::settings::{cache_stride, Settings};
 use crate::stats::{Counters, Stats};
-use std::time::Instant;
+use std::time::{Duration, Instant};
+
+/// Photon mapping: a pass is its photon stage ([`photon_pass`]) with the
+/// pass's estimates ([`Estimates::progressive`]), then the camera pass
+/// with the photon-mapping estimator over its maps.
+pub struct PhotonMapping {
+    pub settings: Settings,
+}
+
+impl RenderMethod for PhotonMapping {
+    fn method(&self) -> Method {
+        Method::Photon
+    }
+
+    fn pass(
+        &self,
+        scene: &Scene,
+        camera: &CameraPass,
+        progress: Mode,
+        rims: &mut Option<Vec<bool>>,
+        stats: &mut Stats,
+    ) -> Film {
+        let settings = &self.settings;
+        let est = Estimates::progressive(scene, settings, camera.pass as u32);
+        (stats.r_global, stats.r_caustic, stats.k_global, stats.k_caustic) =
+            (est.r_global, est.r_caustic, est.k_global, est.k_caustic);
+        let maps = photon_pass(scene, settings, camera.pass, est, progress, stats);
+        let integrator = photon_integrator(scene, settings, &maps, est);
+        shoot(camera, &integrator, progress, rims, stats)
+    }
+
+    fn summary(&self, s: &Stats) -> MethodSummary {
+        let st = &self.settings;
+        let secs = |d: Duration| d.as_secs_f64();
+        let per_s = |n: u64, d: Duration| n as f64 / secs(d).max(1e-9) / 1e6;
+        let pct = |a: u64, b: u64| 100.0 * a as f64 / b.max(1) as f64;
+        let last = if s.passes > 1 { " (last pass)" } else { "" };
+        let mut out = vec![
+            format!(
+                "  global map   {:>11} emitted {:>11} stored{last}; {:.1}% first hit mirror/glass",
+                s.global_emitted,
+                s.global_stored,
+                pct(s.global_specular_hits, s.global_emitted)
+            ),
+            format!(
+                "  caustic map  {:>11} emitted {:>11} stored; {:.1}% aimed hit mirror/glass",
+                s.caustic_emitted,
+                s.caustic_stored,
+                pct(s.caustic_aimed_hits, s.caustic_emitted)
+            ),
+        ];
+        if s.caustic_targets.len() > 1 {
+            for (k, &(object, aimed, hit)) in s.caustic_targets.iter().enumerate().take(8) {
+                out.push(format!(
+                    "               target {k} (shape {object}): {:.1}% of {aimed} aimed hit mirror/glass",
+                    pct(hit, aimed)
+                ));
+            }
+            if s.caustic_targets.len() > 8 {
+                out.push(format!("               ... and {} more targets", s.caustic_targets.len() - 8));
+            }
+        }
+        out.push(format!(
+            "               {:.1} MB of maps, {} cache points; radius caps {:.3} global, {:.3} caustic",
+            s.map_bytes as f64 / 1e6,
+            s.cache_points,
+            s.r_global,
+            s.r_caustic
+        ));
+        if s.spots > 0 {
+            let plural = if s.spots == 1 { "" } else { "s" };
+            out.push(format!("               {} bright spot{plural} for final gathering to aim at", s.spots));
+        }
+        out.push(format!(
+            "  photon pass  {:>8.3} s  {:>7.2} M photons/s  {:>7.2} M rays/s",
+            secs(s.photon_time),
+            per_s(s.global_emitted + s.caustic_emitted, s.photon_time),
+            per_s(s.photon_rays, s.photon_time)
+        ));
+        out.push(format!(
+            "  map build    {:>8.3} s  (maps {:.3} s, irradiance cache {:.3} s)",
+            secs(s.build_time()),
+            secs(s.tree_time),
+            secs(s.cache_time)
+        ));
+        let camera = match st.aimed_rays() {
+            0 => format!(", {} gather", st.gather_rays),
+            aimed => format!(", {} gather ({aimed} aimed)", st.gather_rays),
+        };
+        let mut skipped = Vec::new();
+        if s.skipped_global {
+            skipped.push("the global map (nothing diffuse reflects light)".to_string());
+        }
+        if s.skipped_caustic {
+            skipped.push("the caustic map (no mirror or glass, or nothing diffuse)".to_string());
+        }
+        MethodSummary { lines: out, camera, skipped }
+    }
+}
 
 /// The density-estimation settings of one photon-mapping pass: k nearest
 /// photons within a radius cap, for the global (irradiance) and caustic maps.
@@ -38,8 +140,8 @@ impl Estimates {
         Estimates {
             k_global: k(settings.k_global),
             k_caustic: k(settings.k_caustic),
-            r_global: settings.r_global(scene) * s.sqrt() as f32,
-            r_caustic: settings.r_caustic(scene) * s.sqrt() as f32,
+            r_global: settings.r_global(scene.diagonal()) * s.sqrt() as f32,
+            r_caustic: settings.r_caustic(scene.diagonal()) * s.sqrt() as f32,
         }
     }
 }

@@ -9,15 +9,14 @@
 //! in any order, and added into the same image as one process would make.
 
 use super::accumulation::Accumulation;
-use super::error_estimate::{BiasModel, ErrorEstimate, Prediction};
-use super::photon_stage::shrink;
+use super::error_estimate::{ErrorEstimate, Prediction};
 use super::render_pass;
 use crate::film::Film;
 use crate::interrupt;
 use crate::metrics::Window;
 use crate::progress::Mode;
 use crate::scene::Scene;
-use crate::settings::{Method, Settings};
+use crate::settings::Settings;
 use crate::stats::Stats;
 use std::ops::ControlFlow;
 use std::time::{Duration, Instant};
@@ -101,22 +100,6 @@ impl Run {
     }
 }
 
-/// How `settings`' passes are biased.
-pub fn bias_model(settings: &Settings) -> BiasModel {
-    match settings.method {
-        Method::Photon => BiasModel::Shrinking { alpha: settings.alpha },
-        Method::Path => BiasModel::None,
-    }
-}
-
-/// The shrink factor of pass `pass` (0 where the estimator has none).
-pub fn pass_shrink(settings: &Settings, pass: u32) -> f64 {
-    match settings.method {
-        Method::Photon => shrink(settings.alpha, pass),
-        Method::Path => 0.0,
-    }
-}
-
 /// Renders passes `first`, `first + 1`, … into `start` (empty for a new
 /// render, a partial's sums to resume one) until `budget` says stop;
 /// `on_pass` sees the running average after every pass and may stop the
@@ -130,7 +113,8 @@ pub fn render_passes(
     mut on_pass: impl FnMut(&PassReport) -> ControlFlow<()>,
 ) -> Run {
     let start = Instant::now();
-    let model = bias_model(settings);
+    let model = settings.method.bias(settings.alpha);
+    let unit = settings.method.unit(settings);
     let mut stats = Stats::default();
     let mut pass = first;
     let mut last_pass_time = Duration::ZERO;
@@ -161,13 +145,13 @@ pub fn render_passes(
             }
         }
         let t = Instant::now();
-        let (film, pass_stats) = render_pass(scene, settings, pass, Mode::Quiet, &mut rims);
+        let (film, pass_stats) = render_pass(scene, settings, unit.as_ref(), pass, Mode::Quiet, &mut rims);
         if interrupt::requested() {
             // The pass was cut short: not a pass of the image.
             break Stopped::Interrupted;
         }
         stats.absorb(pass_stats);
-        acc.add_pass(pass, &film, pass_shrink(settings, pass)).expect("a pass is rendered once");
+        acc.add_pass(pass, &film, model.shrink(pass)).expect("a pass is rendered once");
         pass += 1;
         last_pass_time = t.elapsed();
         error = ErrorEstimate::new(&acc, model);

@@ -1,9 +1,30 @@
 //! Option values shared by the commands: parsers that say what is wrong
 //! with a value, the tone map, windows.
 
+use clap::builder::PossibleValue;
 use clap::ValueEnum;
 use photonmap::film::ToneMap;
 use photonmap::metrics::Window;
+use photonmap::render::Method;
+use std::sync::LazyLock;
+
+/// A render method (`--integrator`): those of the library's table that
+/// estimate radiance, by their names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MethodArg(pub Method);
+
+static METHODS: LazyLock<Vec<MethodArg>> =
+    LazyLock::new(|| Method::ALL.into_iter().filter(|m| m.estimates_radiance()).map(MethodArg).collect());
+
+impl ValueEnum for MethodArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        &METHODS
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(self.0.name()).help(self.0.description()))
+    }
+}
 
 /// How 8-bit outputs are made from radiance (`--tonemap`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

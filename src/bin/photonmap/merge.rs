@@ -7,8 +7,9 @@ use crate::outputs::Outputs;
 use crate::write::{write_outputs, Written};
 use photonmap::error::Error;
 use photonmap::output::partial::{merge, read_partial, Partial};
-use photonmap::render::error_estimate::{BiasModel, ErrorEstimate};
+use photonmap::render::error_estimate::ErrorEstimate;
 use photonmap::render::progressive::predict;
+use photonmap::render::Method;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -71,10 +72,9 @@ pub fn run(args: Args) -> Result<(), Error> {
         }
     }
     let film = merged.accumulation.average();
-    let model = match m.method.as_str() {
-        "path" => BiasModel::None,
-        _ => BiasModel::Shrinking { alpha: m.alpha },
-    };
+    let model = Method::from_name(&m.method)
+        .ok_or_else(|| Error::Invalid(format!("merge: the parts name an unknown method \"{}\"", m.method)))?
+        .bias(m.alpha);
     let error = ErrorEstimate::new(&merged.accumulation, model);
     let photons: u64 = m.parts.iter().map(|p| p.photons).sum();
     let seconds: f64 = m.parts.iter().map(|p| p.seconds).sum();

@@ -16,7 +16,7 @@ use photonmap::metrics::{reduction_factor, Window};
 use photonmap::output::partial::{read_partial, Manifest, Part, Partial};
 use photonmap::output::read_exr;
 use photonmap::progress::{Mode, PassDisplay, Wait};
-use photonmap::provenance::{method_name, settings_key, SceneId};
+use photonmap::provenance::{settings_key, SceneId};
 use photonmap::render::accumulation::{parse_range, Accumulation};
 use photonmap::render::{render, render_passes, Budget, Stopped};
 use photonmap::scene::{Eye, Scene};
@@ -25,15 +25,6 @@ use photonmap::stats::counted;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::time::Instant;
-
-/// The estimator (`--integrator`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-enum IntegratorArg {
-    /// Photon mapping: direct light, caustic map, final gathering.
-    Photon,
-    /// Path tracing with next-event estimation (unbiased, the reference).
-    Path,
-}
 
 /// Outputs of a progressive render are rewritten this often, so a run
 /// that dies keeps an image (and a partial) of its passes so far.
@@ -71,7 +62,7 @@ pub struct RenderArgs {
     /// path for a Mitsuba scene whose integrator stops paths at 3 or more
     /// vertices (max_depth), which photon mapping cannot do.
     #[arg(long, value_enum)]
-    integrator: Option<IntegratorArg>,
+    integrator: Option<MethodArg>,
     /// Progressive rendering: passes 0 to N-1, averaged (with --resume:
     /// until the image holds N passes). Photon mapping narrows its
     /// estimates from pass to pass so the image converges to the true one.
@@ -268,7 +259,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
             .map_err(|e| Error::Invalid(format!("--threads: {e}")))?;
     }
 
-    let mut integrator = cli.integrator.unwrap_or(IntegratorArg::Photon);
+    let mut integrator = cli.integrator.map_or(Method::Photon, |m| m.0);
     let loading = Instant::now();
     let wait = Wait::start(Mode::detect(cli.quiet), loading_line(cli.scene.as_deref()));
     let (mut scene, file_spp, scene_id) = match &cli.scene {
@@ -283,7 +274,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
             let mut imported =
                 photonmap::scene::mitsuba::load(path, &options).map_err(|e| Error::Invalid(e.to_string()))?;
             match (imported.photon_limit.take(), cli.integrator) {
-                (Some(e), Some(IntegratorArg::Photon)) => {
+                (Some(e), Some(MethodArg(Method::Photon))) => {
                     if !cli.substitute {
                         return Err(Error::Invalid(e.to_string()));
                     }
@@ -291,7 +282,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
                     imported.file.parts.paths.max_depth = None;
                 }
                 (Some(_), None) => {
-                    integrator = IntegratorArg::Path;
+                    integrator = Method::Path;
                     if !cli.quiet {
                         let depth = imported.file.parts.paths.max_depth.unwrap_or(0);
                         eprintln!(
@@ -352,7 +343,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
     if let Some(path) = &cli.reference {
         reference_shows(path, &scene_id, cli.quiet)?;
     }
-    if integrator == IntegratorArg::Path {
+    if integrator == Method::Path {
         path_tracer_sees(&scene, cli.quiet)?;
     }
 
@@ -366,10 +357,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
         false => (cli.photons.unwrap_or(DEFAULT.photons), cli.spp.unwrap_or(file_spp)),
     };
     let settings = Settings {
-        method: match integrator {
-            IntegratorArg::Photon => Method::Photon,
-            IntegratorArg::Path => Method::Path,
-        },
+        method: integrator,
         alpha: cli.alpha,
         photons,
         caustic_photons: cli.caustic_photons.unwrap_or(photons),
@@ -430,7 +418,7 @@ pub fn run(cli: RenderArgs) -> Result<Outcome, Error> {
         settings: settings_key(&settings),
         width,
         height,
-        method: method_name(settings.method).into(),
+        method: settings.method.name().into(),
         alpha: settings.alpha,
         passes: String::new(),
         parts: Vec::new(),

@@ -3,8 +3,8 @@
 
 use photonmap::error::Error;
 use photonmap::metrics::compare;
+use photonmap::render::summary::Summary;
 use photonmap::settings::Settings;
-use photonmap::stats::Summary;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -23,9 +23,11 @@ pub fn finish(
     predictions: &[(String, photonmap::render::error_estimate::Prediction)],
 ) -> Result<(), Error> {
     if !quiet {
+        let unit = settings.method.unit(settings);
         let summary = Summary {
             stats,
             settings,
+            method: unit.as_ref(),
             threads: rayon::current_num_threads(),
             load_time,
             write_time,
