@@ -17,7 +17,7 @@ use photonmap::envmap::EnvMap;
 use photonmap::film::Film;
 use photonmap::integrator::path::PathIntegrator;
 use photonmap::integrator::{Context, Integrator, Part};
-use photonmap::light::{AreaLight, Emitting, Light};
+use photonmap::light::{AreaLight, Constant, Emitting, Environment, Light, PointLight};
 use photonmap::material::{Distribution, Material};
 use photonmap::math::Color;
 use photonmap::progress::Mode;
@@ -290,7 +290,7 @@ fn points() -> [(Vec3, Vec3); 3] {
     ]
 }
 
-/// Each light's `incident_around` against its `pdf_around`, at several
+/// Each light's `sample_li` against its `pdf_li`, at several
 /// points: area lights (disk, triangle) close enough to cover many cells,
 /// the constant sky (cosine about the normal), the environment map.
 #[test]
@@ -302,8 +302,8 @@ fn lights_sample_their_own_density() {
     let lights = [
         ("disk", Light::Area(AreaLight::new(Emitting::Disk(disk), Color::ONE, 0))),
         ("triangle", Light::Area(AreaLight::new(Emitting::Triangle(triangle), Color::ONE, 0))),
-        ("constant", Light::Constant { radiance: Color::ONE, center: Vec3::ZERO, radius: 1.0 }),
-        ("envmap", Light::Envmap { map: sky_map(), center: Vec3::ZERO, radius: 1.0 }),
+        ("constant", Light::Constant(Constant { radiance: Color::ONE, center: Vec3::ZERO, radius: 1.0 })),
+        ("envmap", Light::Envmap(Environment { map: sky_map(), center: Vec3::ZERO, radius: 1.0 })),
     ];
     let tests = lights.len() * points().len();
     let mut failed = Vec::new();
@@ -312,8 +312,8 @@ fn lights_sample_their_own_density() {
             let mut rng = stream(31, Domain::Camera, (i * 10 + j) as u64);
             let chi2 = Chi2 { cos_bins: 24, phi_bins: 48, tests, ..Chi2::default() };
             let o = chi2.run(
-                || light.incident_around(p, n, next_2d(&mut rng)).map(|inc| inc.dir),
-                |w| light.pdf_around(p, n, w.normalize()) as f64,
+                || light.sample_li(p, n, next_2d(&mut rng)).map(|inc| inc.dir),
+                |w| light.pdf_li(p, n, w.normalize()) as f64,
             );
             eprintln!(
                 "{name} at {p:.2}: chi2 {:.1} dof {} p {:.4} (level {:.5}) pdf mass {:.4}",
@@ -330,8 +330,8 @@ fn lights_sample_their_own_density() {
             // pixel border).
             let mut differ = 0;
             for _ in 0..10_000 {
-                if let Some(inc) = light.incident_around(p, n, next_2d(&mut rng)) {
-                    let (a, b) = (light.pdf_of(p, n, &inc), light.pdf_around(p, n, inc.dir));
+                if let Some(inc) = light.sample_li(p, n, next_2d(&mut rng)) {
+                    let (a, b) = (light.pdf_li_of(p, n, &inc), light.pdf_li(p, n, inc.dir));
                     assert!(a > 0.0, "{name} at {p}: a sample of density {a}");
                     differ += ((a - b).abs() > 1e-3 * a) as u32;
                 }
@@ -341,8 +341,8 @@ fn lights_sample_their_own_density() {
     }
     assert!(failed.is_empty(), "{failed:?}");
     // Delta lights have no density: no sampled direction meets them.
-    let point = Light::Point { position: Vec3::Z, intensity: Color::ONE, falloff: 2.0, dead_distance: 0.0 };
-    assert_eq!(point.pdf_around(Vec3::ZERO, Vec3::Z, Vec3::Z), 0.0);
+    let point = Light::Point(PointLight { position: Vec3::Z, intensity: Color::ONE, falloff: 2.0, dead_distance: 0.0 });
+    assert_eq!(point.pdf_li(Vec3::ZERO, Vec3::Z, Vec3::Z), 0.0);
 }
 
 /// A rough glass ball (GGX 0.02) in a white furnace: a constant sky of

@@ -46,7 +46,7 @@ pub fn direct_light(
             for (j, slot) in pair.iter_mut().enumerate().take((count - s) as usize) {
                 let u = stratified_2d(s + j as u32, count, next_2d(ctx.rng));
                 *slot = light
-                    .incident_around(hit.point, n, u)
+                    .sample_li(hit.point, n, u)
                     .map(|inc| (n.dot(inc.dir), inc))
                     .filter(|&(c, inc)| facing(c, both_sides) && reaches(hit, n, inc.dir, c > 0.0));
             }
@@ -96,14 +96,14 @@ pub fn direct_light_mis(
         let mut sum = Color::ZERO;
         for s in 0..count {
             let u = stratified_2d(s, count, next_2d(ctx.rng));
-            let Some(inc) = light.incident_around(hit.point, n, u) else { continue };
+            let Some(inc) = light.sample_li(hit.point, n, u) else { continue };
             let cos_x = n.dot(inc.dir);
             if facing(cos_x, both_sides) && reaches(hit, n, inc.dir, cos_x > 0.0) && unshadowed(scene, hit, &inc, ctx) {
                 let f = bsdf(inc.dir);
                 let w = if light.is_delta() {
                     1.0
                 } else {
-                    power_heuristic(share, light.pdf_of(hit.point, n, &inc), 1.0, f.pdf)
+                    power_heuristic(share, light.pdf_li_of(hit.point, n, &inc), 1.0, f.pdf)
                 };
                 sum += (f.alone + f.shared * w) * inc.intensity * cos_x.abs();
             }
@@ -144,7 +144,7 @@ pub fn direct_light_one_at_a_time(
         let mut sum = Color::ZERO;
         for s in 0..count {
             let u = stratified_2d(s, count, next_2d(ctx.rng));
-            let Some(inc) = light.incident_around(hit.point, n, u) else { continue };
+            let Some(inc) = light.sample_li(hit.point, n, u) else { continue };
             let cos_x = n.dot(inc.dir);
             if facing(cos_x, both_sides) && reaches(hit, n, inc.dir, cos_x > 0.0) && unshadowed(scene, hit, &inc, ctx) {
                 sum += brdf(inc.dir) * inc.intensity * cos_x.abs();
@@ -272,7 +272,7 @@ mod tests {
                 let mut acc = 0.0f64;
                 for s in 0..m {
                     let u = stratified_2d(s, m, next_2d(ctx.rng));
-                    if let Some(inc) = light.incident_around(hit.point, n, u) {
+                    if let Some(inc) = light.sample_li(hit.point, n, u) {
                         let c = n.dot(inc.dir);
                         if c > 0.0 && unshadowed(&scene, &hit, &inc, &mut ctx) {
                             acc += (brdf(inc.dir) * inc.intensity * c).x as f64;

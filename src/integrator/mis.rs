@@ -83,7 +83,7 @@ impl BsdfSample {
         for (index, light) in scene.lights.iter().enumerate() {
             let le = light.radiance_from_infinity(dir);
             if le != Color::ZERO {
-                sum += le * self.weight(scene, index, light.pdf_around(self.point, self.normal, dir));
+                sum += le * self.weight(scene, index, light.pdf_li(self.point, self.normal, dir));
             }
         }
         sum

@@ -35,8 +35,8 @@ pub fn specular_shares(scene: &Scene) -> Vec<SpecularShare> {
             // The position's numbers run across the grid the other way, so
             // a directional light's rays cover its disk and directions alike.
             // Only where the ray goes counts, not what it carries.
-            let emitted = l.emit(Vec2::new(u.y, u.x), u);
-            if let Some(hit) = scene.intersect(&emitted.0, emitted.1) {
+            let emitted = l.sample_le(Vec2::new(u.y, u.x), u);
+            if let Some(hit) = scene.intersect(&emitted.ray, emitted.departure) {
                 met += 1;
                 specular += scene.material(hit.prim).is_specular() as u32;
             }

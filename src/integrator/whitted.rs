@@ -90,7 +90,7 @@ impl Whitted<'_> {
             let count = if light.is_delta() { 1 } else { AREA_SAMPLES };
             let mut sum = Color::ZERO;
             for s in 0..count {
-                let Some(inc) = light.incident(hit.point, stratified_2d(s, count, next_2d(rng))) else {
+                let Some(inc) = light.sample_li(hit.point, n, stratified_2d(s, count, next_2d(rng))) else {
                     continue;
                 };
                 let cos = inc.dir.dot(n);

@@ -7,13 +7,13 @@
 //! are identical whatever the number of threads.
 
 use super::{Photon, PhotonBlocks};
-use crate::light::Light;
+use crate::light::Aim;
 use crate::material::{Lobe, Transport};
 use crate::math::{max_component, Color, Frame, Ray};
 use crate::sampling::{concentric_disk, next_2d, stream, uniform_cone, uniform_cone_pdf, Domain, Rng};
 use crate::scene::{Scene, Target};
 use crate::shape::Departure;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use rand::RngExt;
 use rayon::prelude::*;
 use std::f32::consts::PI;
@@ -113,124 +113,80 @@ fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> (Option<usize>, Opt
     match pass {
         Pass::Global => {
             // The light's natural distribution: each photon carries power / n.
-            let (ray, departure, weight) = light.emit(next_2d(rng), next_2d(rng));
-            (None, Some((ray, departure, light.power() * scale * weight)))
+            let e = light.sample_le(next_2d(rng), next_2d(rng));
+            (None, Some((e.ray, e.departure, light.power() * scale * e.weight)))
         }
         Pass::Caustic => {
             let targets = scene.specular_targets();
-            let chosen_index = ((rng.random::<f32>() * targets.len() as f32) as usize).min(targets.len() - 1);
-            let chosen = &targets[chosen_index];
-            (Some(chosen_index), aim(targets, chosen_index, chosen, light, scale, rng))
+            let chosen = ((rng.random::<f32>() * targets.len() as f32) as usize).min(targets.len() - 1);
+            // The power is what the light sends along the photon divided by
+            // the density of the aiming: the mixture over all targets.
+            let aimed = light.sample_le_towards(&Aiming { targets, chosen }, rng);
+            (Some(chosen), aimed.map(|a| (a.ray, a.departure, a.intensity * scale / a.pdf)))
         }
     }
 }
 
-/// A caustic photon from `light` towards target `chosen_index`, its power
-/// divided by the pdf of its direction (or, for a directional light, of its
-/// start): the mixture over all targets whose cones (or disks) hold it.
-fn aim(
-    targets: &[Target],
-    chosen_index: usize,
-    chosen: &Target,
-    light: &Light,
-    scale: f32,
-    rng: &mut Rng,
-) -> Option<Emitted> {
-    // Light from everywhere: a uniform direction (pdf 1 / 4π), then as a
-    // directional light of irradiance L 4π along it.
-    let parallel = match *light {
-        Light::Directional { direction, irradiance, reach } => Some((direction, irradiance, reach)),
-        Light::Envmap { ref map, center, radius } => {
-            // A direction drawn from the map: a directional light of
-            // irradiance L / pdf along it.
-            let (towards, pdf) = map.sample(next_2d(rng));
-            if !(pdf > 0.0) {
-                return None;
-            }
-            let direction = -towards;
-            Some((direction, map.eval(towards) / pdf, (center - direction * (2.0 * radius), radius)))
-        }
-        Light::Constant { radiance, center, radius } => {
-            let direction = uniform_cone(next_2d(rng), -1.0).normalize();
-            Some((direction, radiance * (4.0 * PI), (center - direction * (2.0 * radius), radius)))
-        }
-        _ => None,
-    };
-    if let Some((direction, irradiance, reach)) = parallel {
-        // Parallel light: start uniformly on the disk the chosen
-        // object's bounding sphere casts on the emission plane; the
-        // power is E / (pdf_A n), pdf_A the mixture over all disks.
+/// Caustic photons aimed at target `chosen` of `targets`, one chosen
+/// uniformly: a direction uniform in the cone of its bounding sphere seen
+/// from a point, or a start uniform on the disk it casts across parallel
+/// light. Densities are the mixtures over all targets that could have
+/// given the same direction or start.
+struct Aiming<'a> {
+    targets: &'a [Target],
+    chosen: usize,
+}
+
+impl Aim for Aiming<'_> {
+    fn direction_from(&self, origin: Vec3, u: Vec2) -> (Vec3, f32) {
+        let (axis, cos_max) = self.targets[self.chosen].cone_from(origin);
+        // Unit to rounding without normalising (`Frame::to_world`).
+        let dir = Frame::from_normal(axis).to_world(uniform_cone(u, cos_max));
+        // The direction lies in the chosen cone by construction (a test
+        // could deny it by rounding at the rim and leave a zero pdf); the
+        // other cones count where they contain it.
+        let pdf = self
+            .targets
+            .iter()
+            .enumerate()
+            .map(|(j, t)| {
+                if j == self.chosen {
+                    return uniform_cone_pdf(cos_max);
+                }
+                let (a, c) = t.cone_from(origin);
+                if dir.dot(a) >= c {
+                    uniform_cone_pdf(c)
+                } else {
+                    0.0
+                }
+            })
+            .sum::<f32>()
+            / self.targets.len() as f32;
+        (dir, pdf)
+    }
+
+    fn origin_across(&self, direction: Vec3, plane: Vec3, u: Vec2) -> (Vec3, f32) {
         let frame = Frame::from_normal(direction);
-        let project = |c: Vec3| c - direction * (c - reach.0).dot(direction);
-        let d = concentric_disk(next_2d(rng)) * chosen.radius;
+        let project = |c: Vec3| c - direction * (c - plane).dot(direction);
+        let chosen = &self.targets[self.chosen];
+        let d = concentric_disk(u) * chosen.radius;
         let origin = project(chosen.center) + frame.s * d.x + frame.t * d.y;
-        let pdf_area: f32 = targets
+        let pdf = self
+            .targets
             .iter()
             .enumerate()
             .map(|(j, t)| {
                 let inside = (origin - project(t.center)).length_squared() <= t.radius * t.radius;
-                if j == chosen_index || inside {
+                if j == self.chosen || inside {
                     1.0 / (PI * t.radius * t.radius)
                 } else {
                     0.0
                 }
             })
             .sum::<f32>()
-            / targets.len() as f32;
-        return Some((Ray::new(origin, direction), None, irradiance * scale / pdf_area));
+            / self.targets.len() as f32;
+        (origin, pdf)
     }
-    // Direction uniform in the cone of one specular object's bounding
-    // sphere; pdf_w is the mixture over all cones that contain it.
-    let mut emitted = Color::ZERO;
-    let (origin, departure) = match light {
-        Light::Area(a) => {
-            let s = a.sample_point(next_2d(rng));
-            emitted = s.radiance;
-            (s.point, Some(Departure { prim: a.prim, outward: true }))
-        }
-        Light::Point { position, .. } => (*position, None),
-        Light::Spot(s) => (s.position, None),
-        Light::Projector(p) => (p.position, None),
-        Light::Directional { .. } | Light::Constant { .. } | Light::Envmap { .. } => unreachable!("handled above"),
-    };
-    let (axis, cos_max) = chosen.cone_from(origin);
-    // Unit to rounding without normalising (`Frame::to_world`).
-    let dir = Frame::from_normal(axis).to_world(uniform_cone(next_2d(rng), cos_max));
-    // The direction lies in the chosen cone by construction (a test
-    // could deny it by rounding at the rim and leave a zero pdf); the
-    // other cones count where they contain it.
-    let pdf_dir: f32 = targets
-        .iter()
-        .enumerate()
-        .map(|(j, t)| {
-            if j == chosen_index {
-                return uniform_cone_pdf(cos_max);
-            }
-            let (a, c) = t.cone_from(origin);
-            if dir.dot(a) >= c {
-                uniform_cone_pdf(c)
-            } else {
-                0.0
-            }
-        })
-        .sum::<f32>()
-        / targets.len() as f32;
-    // Radiant intensity towards `dir`: L cos A for an area light
-    // (sampled by area), I for a point light.
-    let intensity = match light {
-        Light::Area(a) => {
-            let cos_emit = dir.dot(a.surface.normal());
-            if !(cos_emit > 0.0) {
-                return None;
-            }
-            emitted * cos_emit * a.area()
-        }
-        Light::Point { intensity, .. } => *intensity,
-        Light::Spot(s) => s.intensity_towards(dir.normalize()),
-        Light::Projector(p) => p.intensity_towards(dir.normalize()),
-        Light::Directional { .. } | Light::Constant { .. } | Light::Envmap { .. } => unreachable!("handled above"),
-    };
-    Some((Ray::new(origin, dir), departure, intensity * scale / pdf_dir))
 }
 
 /// One photon on its way: what the next segment needs.

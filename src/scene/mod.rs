@@ -5,7 +5,7 @@
 
 use crate::accel::Accel;
 use crate::camera::Camera;
-use crate::light::{directional_reach, AreaLight, Emitting, Light};
+use crate::light::{AreaLight, Emitting, Light};
 use crate::material::Material;
 use crate::math::{max_component, offset_ray_origin, Color, Frame, Ray, Vertex};
 use crate::sampling::Discrete;
@@ -482,16 +482,16 @@ impl Scene {
                 LightSpec::Point { position, intensity, falloff, dead_distance } => {
                     lo = lo.min(position);
                     hi = hi.max(position);
-                    lights.push(Light::Point { position, intensity, falloff, dead_distance });
+                    lights.push(Light::Point(crate::light::PointLight { position, intensity, falloff, dead_distance }));
                 }
                 LightSpec::Directional { direction, irradiance } => {
-                    lights.push(Light::Directional { direction, irradiance, reach: (Vec3::ZERO, 0.0) });
+                    lights.push(Light::Directional(crate::light::Directional::new(direction, irradiance)));
                 }
                 LightSpec::Constant { radiance } => {
-                    lights.push(Light::Constant { radiance, center: Vec3::ZERO, radius: 0.0 });
+                    lights.push(Light::Constant(crate::light::Constant::new(radiance)));
                 }
                 LightSpec::Envmap(ref map) => {
-                    lights.push(Light::Envmap { map: map.clone(), center: Vec3::ZERO, radius: 0.0 });
+                    lights.push(Light::Envmap(crate::light::Environment::new(map.clone())));
                 }
                 LightSpec::Projector(ref p) => {
                     lo = lo.min(p.position);
@@ -521,23 +521,17 @@ impl Scene {
         }
         // Directional photons start outside everything else.
         for l in &mut lights {
-            match l {
-                Light::Directional { direction, reach, .. } => *reach = directional_reach(*direction, lo, hi),
-                Light::Constant { center, radius, .. } | Light::Envmap { center, radius, .. } => {
-                    (*center, *radius) = directional_reach(Vec3::ZERO, lo, hi)
-                }
-                _ => {}
-            }
+            l.place(lo, hi);
         }
         let background = lights
             .iter()
             .map(|l| match l {
-                Light::Constant { radiance, .. } => *radiance,
+                Light::Constant(c) => c.radiance,
                 _ => Color::ZERO,
             })
             .sum();
         let envmap = lights.iter().find_map(|l| match l {
-            Light::Envmap { map, .. } => Some(map.clone()),
+            Light::Envmap(e) => Some(e.map.clone()),
             _ => None,
         });
         let targets = specular_targets(&prims, &materials);

@@ -4,7 +4,6 @@
 
 use photonmap::error::Error;
 use photonmap::integrator::unseen::specular_shares;
-use photonmap::light::Light;
 use photonmap::output::read_header;
 use photonmap::progress::seconds_to_target;
 use photonmap::provenance::SceneId;
@@ -42,16 +41,6 @@ pub fn reference_shows(reference: &Path, scene: &SceneId, quiet: bool) -> Result
     }
 }
 
-/// A light as a message names it.
-fn describe(light: &Light) -> String {
-    match light {
-        Light::Point { position, .. } => format!("the point light at {position}"),
-        Light::Directional { direction, .. } => format!("the directional light along {direction}"),
-        // Lights without a place to name (other delta lights).
-        _ => format!("a {} light", if light.is_delta() { "delta" } else { "surface" }),
-    }
-}
-
 /// The path tracer finds a point or directional light only by shadow rays,
 /// which no mirror or glass passes: a delta light that reaches the scene
 /// only through them is refused (its light would be missing, a black image
@@ -59,7 +48,7 @@ fn describe(light: &Light) -> String {
 /// warned of (its caustics and reflections are missing).
 pub fn path_tracer_sees(scene: &Scene, quiet: bool) -> Result<(), Error> {
     for s in specular_shares(scene) {
-        let light = describe(&scene.lights[s.light]);
+        let light = scene.lights[s.light].describe();
         if s.share >= 1.0 {
             return Err(Error::Invalid(format!(
                 "--integrator path: {light} reaches the scene only through mirrors or glass; a path tracer \

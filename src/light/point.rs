@@ -1,0 +1,74 @@
+//! A point light: `intensity` (W/sr) equally in every direction; the
+//! Whitted course dims it as 1 / (d + dead_distance)^falloff (physical: 2, 0).
+
+use super::{aimed_from, Aim, Aimed, Emitted, Incident, Source};
+use crate::math::{Color, Ray, Vertex};
+use crate::sampling::{uniform_cone, Rng};
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+#[derive(Clone, Debug)]
+pub struct PointLight {
+    pub position: Vertex,
+    pub intensity: Color,
+    pub falloff: f32,
+    pub dead_distance: f32,
+}
+
+impl Source for PointLight {
+    #[inline]
+    fn sample_li(&self, p: Vertex, _n: Vec3, _u: Vec2) -> Option<Incident> {
+        let to = self.position - p;
+        let dist = to.length();
+        if !(dist > 0.0) {
+            return None;
+        }
+        let scale = (dist + self.dead_distance).powf(-self.falloff);
+        let intensity = self.intensity * scale;
+        intensity.is_finite().then_some(Incident { dir: to / dist, target: Some(self.position), intensity, prim: None })
+    }
+
+    /// A uniform direction.
+    #[inline]
+    fn sample_le(&self, _u_pos: Vec2, u_dir: Vec2) -> Emitted {
+        Emitted {
+            ray: Ray::new(self.position, uniform_cone(u_dir, -1.0).normalize()),
+            departure: None,
+            weight: Color::ONE,
+        }
+    }
+
+    fn pdf_le(&self, _ray: &Ray) -> (f32, f32) {
+        (1.0, 1.0 / (4.0 * PI))
+    }
+
+    #[inline]
+    fn sample_le_towards(&self, aim: &impl Aim, rng: &mut Rng) -> Option<Aimed> {
+        aimed_from(self.position, None, aim, rng, |_| Some(self.intensity))
+    }
+
+    fn power(&self) -> Color {
+        4.0 * PI * self.intensity
+    }
+
+    fn position(&self) -> Option<Vertex> {
+        Some(self.position)
+    }
+
+    fn describe(&self) -> String {
+        format!("the point light at {}", self.position)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn point_light_dims_with_the_course_falloff() {
+        let l = PointLight { position: Vec3::ZERO, intensity: Color::splat(8.0), falloff: 1.0, dead_distance: 2.0 };
+        let inc = l.sample_li(Vec3::new(0.0, 6.0, 0.0), Vec3::Y, Vec2::ZERO).unwrap();
+        assert!((inc.intensity.x - 1.0).abs() < 1e-6);
+        assert!((inc.dir + Vec3::Y).length() < 1e-6);
+    }
+}
