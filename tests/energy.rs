@@ -4,13 +4,13 @@
 //! stored in the global map is the emitted power times 1 / (1 - rho), the
 //! expected number of diffuse hits before absorption).
 
-use photonmap::light::Emitting;
+use photonmap::light::{AreaLight, Emitting};
 use photonmap::material::Material;
 use photonmap::math::Color;
 use photonmap::photon::trace::{trace_pass, Pass};
 use photonmap::progress::Mode;
 use photonmap::render::render;
-use photonmap::scene::{tncg15_room, Eye, LightSpec, Scene, SceneParts};
+use photonmap::scene::{tncg15_room, Eye, Scene, SceneParts};
 use photonmap::settings::{Method, Settings};
 use photonmap::shape::Shape;
 
@@ -25,7 +25,7 @@ fn furnace_with(le: f32, rho: f32, sphere: Option<Material>) -> Scene {
         .into_iter()
         .map(|p| {
             let Shape::Triangle(t) = p.shape else { unreachable!() };
-            LightSpec::Area { surface: Emitting::Triangle(t), radiance: Color::splat(le), material: Some(0) }
+            AreaLight::unplaced(Emitting::Triangle(t), Color::splat(le), Some(0))
         })
         .collect();
     let mut materials = vec![Material::Lambertian { rho: Color::splat(rho) }];

@@ -10,20 +10,19 @@
 
 mod common;
 
-use common::chi2::Chi2;
 use glam::{Mat3, Vec3};
 use photonmap::camera::Camera;
 use photonmap::envmap::EnvMap;
 use photonmap::film::Film;
 use photonmap::integrator::path::PathIntegrator;
 use photonmap::integrator::{Context, Integrator, Part};
-use photonmap::light::{AreaLight, Constant, Emitting, Environment, Light, PointLight};
+use photonmap::light::{AreaLight, Constant, Emitting, Environment, Light};
 use photonmap::material::{Distribution, Material};
 use photonmap::math::Color;
 use photonmap::progress::Mode;
 use photonmap::render::photon_stage::{photon_integrator, photon_pass, Estimates};
 use photonmap::sampling::{next_2d, stream, Domain};
-use photonmap::scene::{Eye, LightSpec, PathLimits, Prim, Scene, SceneParts};
+use photonmap::scene::{Eye, PathLimits, Prim, Scene, SceneParts};
 use photonmap::settings::Settings;
 use photonmap::shape::{Disk, Shape, Sphere, Triangle};
 use photonmap::stats::{Counters, Stats};
@@ -139,9 +138,9 @@ fn open_scene(paths: PathLimits) -> Scene {
         shading_normals: Vec::new(),
         materials,
         lights: vec![
-            LightSpec::Area { surface: Emitting::Disk(light), radiance: Color::splat(30.0), material: None },
-            LightSpec::Constant { radiance: Color::splat(0.3) },
-            LightSpec::Envmap(sky_map()),
+            AreaLight::unplaced(Emitting::Disk(light), Color::splat(30.0), None),
+            Light::Constant(Constant::new(Color::splat(0.3))),
+            Light::Envmap(Environment::new(sky_map())),
         ],
         ambient: Color::ZERO,
         camera,
@@ -281,70 +280,6 @@ fn mis_quiets_glossy_highlights() {
     assert!(path < 0.6 && photon < 0.7, "path tracing {path}, photon mapping {photon}");
 }
 
-/// Shading points about a light: in front, oblique, beside it.
-fn points() -> [(Vec3, Vec3); 3] {
-    [
-        (Vec3::new(0.0, 0.0, 0.0), Vec3::Z),
-        (Vec3::new(0.7, -0.4, 0.2), Vec3::new(0.3, 0.1, 1.0).normalize()),
-        (Vec3::new(-1.5, 0.3, 0.3), Vec3::new(-0.6, 0.0, 0.8).normalize()),
-    ]
-}
-
-/// Each light's `sample_li` against its `pdf_li`, at several
-/// points: area lights (disk, triangle) close enough to cover many cells,
-/// the constant sky (cosine about the normal), the environment map.
-#[test]
-fn lights_sample_their_own_density() {
-    let disk = Disk { center: Vec3::new(0.2, 0.1, 1.2), normal: Vec3::new(0.2, -0.1, -1.0).normalize(), radius: 0.9 };
-    let triangle = Triangle::new(Vec3::new(-1.0, -1.0, 1.0), Vec3::new(1.5, -0.5, 1.6), Vec3::new(-0.5, 1.5, 0.9));
-    let triangle =
-        if triangle.normal.z > 0.0 { Triangle::new(triangle.v0, triangle.v2, triangle.v1) } else { triangle };
-    let lights = [
-        ("disk", Light::Area(AreaLight::new(Emitting::Disk(disk), Color::ONE, 0))),
-        ("triangle", Light::Area(AreaLight::new(Emitting::Triangle(triangle), Color::ONE, 0))),
-        ("constant", Light::Constant(Constant { radiance: Color::ONE, center: Vec3::ZERO, radius: 1.0 })),
-        ("envmap", Light::Envmap(Environment { map: sky_map(), center: Vec3::ZERO, radius: 1.0 })),
-    ];
-    let tests = lights.len() * points().len();
-    let mut failed = Vec::new();
-    for (i, (name, light)) in lights.iter().enumerate() {
-        for (j, (p, n)) in points().into_iter().enumerate() {
-            let mut rng = stream(31, Domain::Camera, (i * 10 + j) as u64);
-            let chi2 = Chi2 { cos_bins: 24, phi_bins: 48, tests, ..Chi2::default() };
-            let o = chi2.run(
-                || light.sample_li(p, n, next_2d(&mut rng)).map(|inc| inc.dir),
-                |w| light.pdf_li(p, n, w.normalize()) as f64,
-            );
-            eprintln!(
-                "{name} at {p:.2}: chi2 {:.1} dof {} p {:.4} (level {:.5}) pdf mass {:.4}",
-                o.statistic, o.dof, o.p_value, o.threshold, o.pdf_mass
-            );
-            if !o.passed() {
-                failed.push(format!("{name} at {p}: p {}", o.p_value));
-            }
-            // Every point sees the light: the test bins something.
-            assert!(o.pdf_mass > 0.01, "{name} at {p}: pdf mass {}", o.pdf_mass);
-            // A sample's own density is the one MIS reads, found again
-            // from its direction alone (but where rounding moves the
-            // direction across a light's rim or an environment map's
-            // pixel border).
-            let mut differ = 0;
-            for _ in 0..10_000 {
-                if let Some(inc) = light.sample_li(p, n, next_2d(&mut rng)) {
-                    let (a, b) = (light.pdf_li_of(p, n, &inc), light.pdf_li(p, n, inc.dir));
-                    assert!(a > 0.0, "{name} at {p}: a sample of density {a}");
-                    differ += ((a - b).abs() > 1e-3 * a) as u32;
-                }
-            }
-            assert!(differ < 10, "{name} at {p}: {differ} of 10000 densities differ");
-        }
-    }
-    assert!(failed.is_empty(), "{failed:?}");
-    // Delta lights have no density: no sampled direction meets them.
-    let point = Light::Point(PointLight { position: Vec3::Z, intensity: Color::ONE, falloff: 2.0, dead_distance: 0.0 });
-    assert_eq!(point.pdf_li(Vec3::ZERO, Vec3::Z, Vec3::Z), 0.0);
-}
-
 /// A rough glass ball (GGX 0.02) in a white furnace: a constant sky of
 /// radiance 1 and nothing else. Every path ends in the sky, so the ball's
 /// radiance is 1 less what Smith's single scattering loses (under 1% at
@@ -370,7 +305,7 @@ fn rough_glass_in_a_furnace_sees_the_sky_through_itself() {
         prims: vec![Prim { shape: Shape::Sphere(Sphere { center: Vec3::ZERO, radius: 1.0 }), material: 0, object: 0 }],
         shading_normals: Vec::new(),
         materials: vec![ball],
-        lights: vec![LightSpec::Constant { radiance: Color::ONE }],
+        lights: vec![Light::Constant(Constant::new(Color::ONE))],
         ambient: Color::ZERO,
         camera,
         one_sided: Vec::new(),

@@ -4,13 +4,14 @@
 
 use glam::{DVec3, Vec3};
 use photonmap::film::Film;
+use photonmap::light::{AreaLight, Light};
 use photonmap::material::Material;
 use photonmap::math::{offset_ray_origin, Color, Ray};
 use photonmap::metrics::compare;
 use photonmap::progress::Mode;
 use photonmap::render::render;
 use photonmap::sampling::{next_2d, stream, Domain};
-use photonmap::scene::{Eye, LightSpec, Prim, Scene, SceneParts};
+use photonmap::scene::{Eye, Prim, Scene, SceneParts};
 use photonmap::settings::Settings;
 use photonmap::shape::{Cylinder, Shape, Sphere, Triangle};
 use proptest::prelude::*;
@@ -420,7 +421,7 @@ fn degenerate_input_renders_finite_images() {
 
     for radiance in [0.0f32, 1e12] {
         let mut p = Scene::tncg15_parts(Eye::One);
-        let LightSpec::Area { radiance: r, .. } = &mut p.lights[0] else { panic!() };
+        let Light::Area(AreaLight { radiance: r, .. }) = &mut p.lights[0] else { panic!() };
         *r = Color::splat(radiance);
         let film = render_parts(p, &small(20_000));
         assert!(radiance > 0.0 || film.mean() == 0.0);

@@ -2,14 +2,14 @@
 //! skip renders the same image with the skip forced off.
 
 use photonmap::film::Film;
-use photonmap::light::Emitting;
+use photonmap::light::{AreaLight, Emitting, Light};
 use photonmap::material::Material;
 use photonmap::metrics::compare;
 use photonmap::photon::map::{PhotonMap, Scratch};
 use photonmap::photon::trace::{trace_pass, Pass};
 use photonmap::progress::Mode;
 use photonmap::render::render;
-use photonmap::scene::{Eye, LightSpec, Scene, SceneParts};
+use photonmap::scene::{Eye, Scene, SceneParts};
 use photonmap::settings::Settings;
 use photonmap::stats::Stats;
 
@@ -97,7 +97,7 @@ fn lights_facing_away_get_no_shadow_rays() {
     for flip in [false, true] {
         let mut parts = Scene::tncg15_parts(Eye::One);
         if flip {
-            let LightSpec::Area { surface: Emitting::Disk(disk), .. } = &mut parts.lights[0] else { panic!() };
+            let Light::Area(AreaLight { surface: Emitting::Disk(disk), .. }) = &mut parts.lights[0] else { panic!() };
             disk.normal = -disk.normal;
         }
         let scene = Scene::from_parts(parts);

@@ -32,12 +32,12 @@
 use super::mitsuba_sensor::sensor;
 use super::ply::PlyMesh;
 use crate::camera::Camera;
-use crate::light::Emitting;
+use crate::light::{AreaLight, Emitting, Light, MitsubaEmitter, MitsubaParam};
 use crate::material::Material;
 use crate::math::{Color, Frame};
 use crate::scene::file::{Origins, Place};
 use crate::scene::procedural::icosphere;
-use crate::scene::{LightSpec, SceneParts};
+use crate::scene::SceneParts;
 use crate::shape::{Ellipsoid, Shape, FLAT};
 use glam::{Affine3A, Vec3};
 use std::fmt::Write;
@@ -120,7 +120,7 @@ pub fn to_mitsuba(
         used[p.material as usize] = true;
     }
     for l in &parts.lights {
-        if let LightSpec::Area { material: Some(m), .. } = l {
+        if let Light::Area(AreaLight { material: Some(m), .. }) = l {
             used[*m as usize] = true;
         }
     }
@@ -228,8 +228,9 @@ pub fn to_mitsuba(
     };
     for (i, l) in parts.lights.iter().enumerate() {
         let light_place = || place(&|o| o.lights.get(i));
-        match *l {
-            LightSpec::Area { surface: Emitting::Triangle(t), radiance, material } => {
+        match l {
+            Light::Area(AreaLight { surface: Emitting::Triangle(t), radiance, material, .. }) => {
+                let (t, radiance, material) = (*t, *radiance, *material);
                 let key = origins.and_then(|o| o.lights.get(i)).map_or(usize::MAX, |p| p.line);
                 let same = tri_run.as_ref().is_some_and(|(k, r, m, _)| *k == key && *r == radiance && *m == material);
                 if !same {
@@ -240,74 +241,22 @@ pub fn to_mitsuba(
                     mesh.push([t.v0, t.v1, t.v2].map(at), [t.normal; 3]);
                 }
             }
-            LightSpec::Area { surface: Emitting::Disk(d), radiance, material } => {
+            Light::Area(AreaLight { surface: Emitting::Disk(d), radiance, material, .. }) => {
                 emitters += &flush(&mut out, &mut tri_run);
                 let _ = write!(
                     emitters,
                     "    <shape type=\"disk\">\n        {}\n{}        <emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>\n    </shape>\n",
                     disk_transform(at(d.center), d.normal, d.radius * s),
-                    bsdf_ref(material),
-                    rgb(radiance)
+                    bsdf_ref(*material),
+                    rgb(*radiance)
                 );
             }
-            LightSpec::Point { position, intensity, falloff, dead_distance } => {
+            // Every other light describes itself, moved as the scene is.
+            other => {
                 emitters += &flush(&mut out, &mut tri_run);
-                if falloff != 2.0 || dead_distance != 0.0 {
-                    return Err(refuse(
-                        light_place(),
-                        format!(
-                            "a point light dimmed as 1/(d + {dead_distance})^{falloff} has no equivalent in Mitsuba 3 \
-                             (its point lights dim as 1/d^2)"
-                        ),
-                    ));
-                }
-                let _ = write!(
-                    emitters,
-                    "    <emitter type=\"point\">\n        <point name=\"position\" value=\"{}\"/>\n        <rgb name=\"intensity\" value=\"{}\"/>\n    </emitter>\n",
-                    xyz(at(position)),
-                    // 1/d^2 with every d scaled.
-                    rgb(intensity * (s * s))
-                );
-            }
-            LightSpec::Directional { direction, irradiance } => {
-                emitters += &flush(&mut out, &mut tri_run);
-                let _ = write!(
-                    emitters,
-                    "    <emitter type=\"directional\">\n        <vector name=\"direction\" value=\"{}\"/>\n        <rgb name=\"irradiance\" value=\"{}\"/>\n    </emitter>\n",
-                    xyz(direction),
-                    rgb(irradiance)
-                );
-            }
-            LightSpec::Envmap(_) => {
-                return Err(refuse(
-                    light_place(),
-                    "the environment map's export to Mitsuba is not written yet".to_string(),
-                ));
-            }
-            LightSpec::Projector(_) => {
-                return Err(refuse(light_place(), "the projector's export to Mitsuba is not written yet".to_string()));
-            }
-            LightSpec::Constant { radiance } => {
-                emitters += &flush(&mut out, &mut tri_run);
-                let _ = write!(
-                    emitters,
-                    "    <emitter type=\"constant\">\n        <rgb name=\"radiance\" value=\"{}\"/>\n    </emitter>\n",
-                    rgb(radiance)
-                );
-            }
-            LightSpec::Spot { position, axis, intensity, cutoff_deg, beam_deg, .. } => {
-                emitters += &flush(&mut out, &mut tri_run);
-                let eye = at(position);
-                let target = eye + axis;
-                let up = if axis.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
-                let _ = write!(
-                    emitters,
-                    "    <emitter type=\"spot\">\n        <transform name=\"to_world\"><lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>\n        <rgb name=\"intensity\" value=\"{}\"/>\n        <float name=\"cutoff_angle\" value=\"{cutoff_deg}\"/>\n        <float name=\"beam_width\" value=\"{beam_deg}\"/>\n    </emitter>\n",
-                    xyz(eye),
-                    xyz(target),
-                    xyz(up),
-                    rgb(intensity * (s * s))
-                );
+                let mut moved = other.clone();
+                moved.moved(placement.origin, s);
+                emitters += &emitter(&moved.mitsuba().map_err(|m| refuse(light_place(), m))?);
             }
         }
     }
@@ -459,9 +408,31 @@ fn rgb(c: Color) -> String {
     xyz(c)
 }
 
+/// A light's `<emitter>` element.
+fn emitter(e: &MitsubaEmitter) -> String {
+    let mut xml = format!("    <emitter type=\"{}\">\n", e.plugin);
+    for (name, param) in &e.params {
+        let _ = match *param {
+            MitsubaParam::Rgb(c) => writeln!(xml, "        <rgb name=\"{name}\" value=\"{}\"/>", rgb(c)),
+            MitsubaParam::Point(p) => writeln!(xml, "        <point name=\"{name}\" value=\"{}\"/>", xyz(p)),
+            MitsubaParam::Vector(v) => writeln!(xml, "        <vector name=\"{name}\" value=\"{}\"/>", xyz(v)),
+            MitsubaParam::Float(x) => writeln!(xml, "        <float name=\"{name}\" value=\"{x}\"/>"),
+            MitsubaParam::LookAt { origin, target, up } => writeln!(
+                xml,
+                "        <transform name=\"{name}\"><lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>",
+                xyz(origin),
+                xyz(target),
+                xyz(up)
+            ),
+        };
+    }
+    xml + "    </emitter>\n"
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::light::PointLight;
     use crate::scene::{Eye, Prim, Scene};
     use crate::shape::Triangle;
 
@@ -517,7 +488,7 @@ mod tests {
         assert_eq!(faces, 28);
     }
 
-    fn parts_with(prims: Vec<Prim>, materials: Vec<Material>, lights: Vec<LightSpec>) -> SceneParts {
+    fn parts_with(prims: Vec<Prim>, materials: Vec<Material>, lights: Vec<Light>) -> SceneParts {
         SceneParts {
             prims,
             shading_normals: Vec::new(),
@@ -546,14 +517,14 @@ mod tests {
             ],
             vec![Material::Glass { ior: 1.33, absorption: Color::new(0.1, 0.2, 0.3) }],
             vec![
-                LightSpec::Directional { direction: Vec3::new(0.0, 0.0, -1.0), irradiance: Color::splat(2.0) },
-                LightSpec::Point {
+                Light::Directional(crate::light::Directional::new(Vec3::new(0.0, 0.0, -1.0), Color::splat(2.0))),
+                Light::Point(PointLight {
                     position: Vec3::ONE,
                     intensity: Color::splat(5.0),
                     falloff: 2.0,
                     dead_distance: 0.0,
-                },
-                LightSpec::Area { surface: Emitting::Triangle(t), radiance: Color::splat(3.0), material: None },
+                }),
+                AreaLight::unplaced(Emitting::Triangle(t), Color::splat(3.0), None),
             ],
         );
         parts.shading_normals.push([Vec3::Z, Vec3::Z, Vec3::new(0.0, 0.6, 0.8)]);
@@ -598,7 +569,8 @@ mod tests {
         let parts = parts_with(vec![Prim { shape: Shape::Triangle(t), material: 0, object: 0 }], vec![phong], vec![]);
         let r = to_mitsuba(&parts, None, "m", Placement::at_eye(&parts.camera)).err().expect("refused");
         assert!(r.message.contains("Phong"));
-        let falloff = LightSpec::Point { position: Vec3::ONE, intensity: Color::ONE, falloff: 1.0, dead_distance: 0.0 };
+        let falloff =
+            Light::Point(PointLight { position: Vec3::ONE, intensity: Color::ONE, falloff: 1.0, dead_distance: 0.0 });
         let parts = parts_with(vec![], vec![], vec![falloff]);
         assert!(to_mitsuba(&parts, None, "m", Placement::at_eye(&parts.camera))
             .err()
@@ -623,12 +595,12 @@ mod tests {
         let parts = parts_with(
             vec![Prim { shape: Shape::Sphere(ball), material: 0, object: 0 }],
             vec![Material::Glass { ior: 1.5, absorption: Color::splat(0.4) }],
-            vec![LightSpec::Point {
+            vec![Light::Point(PointLight {
                 position: Vec3::new(1.0, 1.0, 3.0),
                 intensity: Color::splat(5.0),
                 falloff: 2.0,
                 dead_distance: 0.0,
-            }],
+            })],
         );
         let placement = Placement::new(Vec3::new(3.0, 1.0, 1.0), 100.0).unwrap();
         let x = to_mitsuba(&parts, None, "m", placement).unwrap_or_else(|r| panic!("{}", r.describe(None))).xml;

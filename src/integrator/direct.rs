@@ -235,8 +235,8 @@ mod tests {
     /// under its ceiling, at points of its floor.
     #[test]
     fn drawing_many_lights_by_power_keeps_the_mean() {
-        use crate::light::Emitting;
-        use crate::scene::{LightSpec, Scene};
+        use crate::light::{AreaLight, Emitting};
+        use crate::scene::Scene;
         use crate::shape::Triangle;
         let mut parts = Scene::tncg15_parts(Eye::One);
         for i in 0..100 {
@@ -245,7 +245,7 @@ mod tests {
             // Wound to face down, into the room.
             let t = Triangle::new(v(0.0, 0.0), v(0.0, 0.3), v(0.3, 0.0));
             let radiance = Color::splat(1.0 + (i % 7) as f32);
-            parts.lights.push(LightSpec::Area { surface: Emitting::Triangle(t), radiance, material: None });
+            parts.lights.push(AreaLight::unplaced(Emitting::Triangle(t), radiance, None));
         }
         let scene = Scene::from_parts(parts);
         assert!(scene.many_lights());

@@ -51,8 +51,9 @@ pub fn specular_shares(scene: &Scene) -> Vec<SpecularShare> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::light::{Light, PointLight};
     use crate::material::Material;
-    use crate::scene::{Eye, LightSpec, Prim, Scene};
+    use crate::scene::{Eye, Prim, Scene};
     use crate::shape::{Shape, Sphere};
     use glam::Vec3;
 
@@ -60,12 +61,12 @@ mod tests {
         let mut parts = Scene::tncg15_parts(Eye::One);
         parts.lights.clear();
         let position = Vec3::new(6.0, 0.0, 0.0);
-        parts.lights.push(LightSpec::Point {
+        parts.lights.push(Light::Point(PointLight {
             position,
             intensity: Vec3::splat(10.0),
             falloff: 2.0,
             dead_distance: 0.0,
-        });
+        }));
         if in_glass {
             parts.materials.push(Material::glass(1.5));
             let glass = parts.materials.len() as u32 - 1;

@@ -2,10 +2,10 @@
 //! radiance or of an image's over a triangle (Mitsuba's area emitter with
 //! a radiance texture). Its surface is a primitive of the scene too.
 
-use super::{aimed_from, Aim, Aimed, Emitted, Incident, Source};
+use super::{aimed_from, Aim, Aimed, Emitted, Incident, Light, Source};
 use crate::math::{Color, Frame, Ray, Vertex};
 use crate::sampling::{concentric_disk, cosine_hemisphere, next_2d, uniform_triangle, Rng};
-use crate::shape::{Departure, Disk, RayShear, Triangle};
+use crate::shape::{Departure, Disk, RayShear, Shape, Triangle};
 use crate::texture::{SurfacePoint, Texture};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -42,6 +42,24 @@ impl Emitting {
         }
     }
 
+    /// The surface as a primitive's shape.
+    pub fn shape(&self) -> Shape {
+        match *self {
+            Emitting::Disk(d) => Shape::Disk(d),
+            Emitting::Triangle(t) => Shape::Triangle(t),
+        }
+    }
+
+    /// The surface in a scene whose every point p becomes (p - `origin`)
+    /// `scale`.
+    fn moved(&self, origin: Vec3, scale: f32) -> Self {
+        let at = |p: Vec3| (p - origin) * scale;
+        match *self {
+            Emitting::Disk(d) => Emitting::Disk(Disk { center: at(d.center), radius: d.radius * scale, ..d }),
+            Emitting::Triangle(t) => Emitting::Triangle(Triangle::new(at(t.v0), at(t.v1), at(t.v2))),
+        }
+    }
+
     /// Where a ray meets the surface (either side), if it does.
     fn distance(&self, ray: &Ray) -> Option<f32> {
         match self {
@@ -70,6 +88,9 @@ pub struct AreaLight {
     pub radiance: Color,
     /// Index of the surface's primitive in the scene (shadow rays ignore it).
     pub prim: u32,
+    /// The material its surface reflects with (a glowing wall); `None`: a
+    /// pure emitter, black to the light that reaches it.
+    pub material: Option<u32>,
     frame: Frame,
     pattern: Option<Arc<AreaPattern>>,
 }
@@ -121,7 +142,30 @@ pub struct LightSample {
 
 impl AreaLight {
     pub fn new(surface: Emitting, radiance: Color, prim: u32) -> Self {
-        AreaLight { surface, radiance, prim, frame: Frame::from_normal(surface.normal()), pattern: None }
+        AreaLight {
+            surface,
+            radiance,
+            prim,
+            material: None,
+            frame: Frame::from_normal(surface.normal()),
+            pattern: None,
+        }
+    }
+
+    /// A light as a scene describes it, before the scene makes its surface
+    /// a primitive ([`Self::placed`]).
+    pub fn unplaced(surface: Emitting, radiance: Color, material: Option<u32>) -> Light {
+        Light::Area(AreaLight { material, ..AreaLight::new(surface, radiance, u32::MAX) })
+    }
+
+    /// The light whose surface is primitive `prim` of the scene, with its
+    /// image (or `pattern`, given by the scene's textures).
+    pub fn placed(&self, prim: u32, pattern: Option<Arc<AreaPattern>>) -> Self {
+        let light = AreaLight { material: self.material, ..AreaLight::new(self.surface, self.radiance, prim) };
+        match pattern.or_else(|| self.pattern.clone()) {
+            Some(p) => light.with_pattern(p),
+            None => light,
+        }
     }
 
     /// The light with an image's radiance over its triangle; its
@@ -267,6 +311,20 @@ impl Source for AreaLight {
     #[inline]
     fn faces_away(&self, p: Vertex) -> bool {
         (p - self.surface.anchor()).dot(self.surface.normal()) <= 0.0
+    }
+
+    fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        Some(self.surface.shape().bounds())
+    }
+
+    fn moved(&mut self, origin: Vec3, scale: f32) {
+        let pattern = self.pattern.clone();
+        let radiance = self.radiance;
+        *self = AreaLight {
+            material: self.material,
+            ..AreaLight::new(self.surface.moved(origin, scale), radiance, self.prim)
+        };
+        self.pattern = pattern;
     }
 
     fn describe(&self) -> String {

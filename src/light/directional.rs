@@ -2,7 +2,10 @@
 //! of `irradiance` on a surface facing it. Photons start on a disk facing
 //! the light that covers the scene (`reach`: its centre and radius).
 
-use super::{aimed_across, directional_reach, disk_pdf, disk_point, Aim, Aimed, Emitted, Incident, Source};
+use super::{
+    aimed_across, directional_reach, disk_pdf, disk_point, Aim, Aimed, Emitted, Incident, MitsubaEmitter, MitsubaParam,
+    Source,
+};
 use crate::math::{Color, Ray, Vertex};
 use crate::sampling::Rng;
 use glam::{Vec2, Vec3};
@@ -52,7 +55,20 @@ impl Source for Directional {
         self.reach = directional_reach(self.direction, lo, hi);
     }
 
+    /// Light from infinity keeps its radiance where the scene moves.
+    fn moved(&mut self, _origin: Vec3, _scale: f32) {}
+
     fn describe(&self) -> String {
         format!("the directional light along {}", self.direction)
+    }
+
+    fn mitsuba(&self) -> Result<MitsubaEmitter, String> {
+        Ok(MitsubaEmitter {
+            plugin: "directional",
+            params: vec![
+                ("direction", MitsubaParam::Vector(self.direction)),
+                ("irradiance", MitsubaParam::Rgb(self.irradiance)),
+            ],
+        })
     }
 }

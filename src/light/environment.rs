@@ -87,6 +87,9 @@ impl Source for Environment {
         (self.center, self.radius) = directional_reach(Vec3::ZERO, lo, hi);
     }
 
+    /// Light from infinity keeps its radiance where the scene moves.
+    fn moved(&mut self, _origin: Vec3, _scale: f32) {}
+
     fn describe(&self) -> String {
         "the environment map".to_string()
     }

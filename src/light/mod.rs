@@ -150,8 +150,9 @@ pub trait Source {
         Color::ZERO
     }
 
-    /// Where the light sits, for the scene's bounds (a light at a point).
-    fn position(&self) -> Option<Vertex> {
+    /// The box the light occupies, which the scene's bounds hold (`None`:
+    /// light from infinity).
+    fn bounds(&self) -> Option<(Vec3, Vec3)> {
         None
     }
 
@@ -159,8 +160,42 @@ pub trait Source {
     /// infinity starts its photons outside it.
     fn place(&mut self, _lo: Vec3, _hi: Vec3) {}
 
+    /// The same light in a scene whose every point p becomes
+    /// (p - `origin`) `scale` (`scale` > 0): positions move, and a light
+    /// from a point scales its intensity by scale², which keeps the
+    /// irradiance I / d² it gives.
+    fn moved(&mut self, origin: Vec3, scale: f32);
+
     /// How a message names the light.
     fn describe(&self) -> String;
+
+    /// The light as Mitsuba 3's emitter plugin (for the export), or why
+    /// there is none.
+    fn mitsuba(&self) -> Result<MitsubaEmitter, String> {
+        Err(format!("{}: its export to Mitsuba 3 is not written yet", self.describe()))
+    }
+}
+
+/// A light as a Mitsuba 3 `<emitter>`: its plugin name and parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MitsubaEmitter {
+    pub plugin: &'static str,
+    pub params: Vec<(&'static str, MitsubaParam)>,
+}
+
+/// A parameter of a [`MitsubaEmitter`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MitsubaParam {
+    Rgb(Color),
+    Point(Vec3),
+    Vector(Vec3),
+    Float(f32),
+    /// A `to_world` transform looking from `origin` at `target`.
+    LookAt {
+        origin: Vec3,
+        target: Vec3,
+        up: Vec3,
+    },
 }
 
 /// A light of the scene.
@@ -256,9 +291,9 @@ impl Light {
         each!(self, l => l.radiance_from_infinity(towards))
     }
 
-    /// See [`Source::position`].
-    pub fn position(&self) -> Option<Vertex> {
-        each!(self, l => l.position())
+    /// See [`Source::bounds`].
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        each!(self, l => l.bounds())
     }
 
     /// See [`Source::place`].
@@ -266,10 +301,38 @@ impl Light {
         each!(self, l => l.place(lo, hi))
     }
 
+    /// See [`Source::moved`].
+    pub fn moved(&mut self, origin: Vec3, scale: f32) {
+        each!(self, l => l.moved(origin, scale))
+    }
+
     /// See [`Source::describe`].
     pub fn describe(&self) -> String {
         each!(self, l => l.describe())
     }
+
+    /// See [`Source::mitsuba`].
+    pub fn mitsuba(&self) -> Result<MitsubaEmitter, String> {
+        each!(self, l => l.mitsuba())
+    }
+}
+
+/// Places `lights` in a scene whose primitives span (`lo`, `hi`), and
+/// returns the scene's box: the primitives' and the lights' own
+/// (zero-sized at the origin where there is nothing). Light from infinity
+/// starts its photons outside that box.
+pub fn place_lights(lights: &mut [Light], mut lo: Vec3, mut hi: Vec3) -> (Vec3, Vec3) {
+    for (a, b) in lights.iter().filter_map(Light::bounds) {
+        lo = lo.min(a);
+        hi = hi.max(b);
+    }
+    if !(lo.x <= hi.x) {
+        (lo, hi) = (Vec3::ZERO, Vec3::ZERO);
+    }
+    for l in lights.iter_mut() {
+        l.place(lo, hi);
+    }
+    (lo, hi)
 }
 
 /// A photon from `origin` aimed by `aim`, carrying the intensity

@@ -1,7 +1,7 @@
 //! A point light: `intensity` (W/sr) equally in every direction; the
 //! Whitted course dims it as 1 / (d + dead_distance)^falloff (physical: 2, 0).
 
-use super::{aimed_from, Aim, Aimed, Emitted, Incident, Source};
+use super::{aimed_from, Aim, Aimed, Emitted, Incident, MitsubaEmitter, MitsubaParam, Source};
 use crate::math::{Color, Ray, Vertex};
 use crate::sampling::{uniform_cone, Rng};
 use glam::{Vec2, Vec3};
@@ -51,12 +51,34 @@ impl Source for PointLight {
         4.0 * PI * self.intensity
     }
 
-    fn position(&self) -> Option<Vertex> {
-        Some(self.position)
+    fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        Some((self.position, self.position))
+    }
+
+    fn moved(&mut self, origin: Vec3, scale: f32) {
+        self.position = (self.position - origin) * scale;
+        self.intensity *= scale * scale;
     }
 
     fn describe(&self) -> String {
         format!("the point light at {}", self.position)
+    }
+
+    fn mitsuba(&self) -> Result<MitsubaEmitter, String> {
+        let (falloff, dead_distance) = (self.falloff, self.dead_distance);
+        if falloff != 2.0 || dead_distance != 0.0 {
+            return Err(format!(
+                "a point light dimmed as 1/(d + {dead_distance})^{falloff} has no equivalent in Mitsuba 3 (its \
+                 point lights dim as 1/d^2)"
+            ));
+        }
+        Ok(MitsubaEmitter {
+            plugin: "point",
+            params: vec![
+                ("position", MitsubaParam::Point(self.position)),
+                ("intensity", MitsubaParam::Rgb(self.intensity)),
+            ],
+        })
     }
 }
 

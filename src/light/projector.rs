@@ -129,8 +129,13 @@ impl Source for Projector {
         self.scaled * self.mean() * (4.0 * self.tan_x * self.tan_y)
     }
 
-    fn position(&self) -> Option<Vertex> {
-        Some(self.position)
+    fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        Some((self.position, self.position))
+    }
+
+    fn moved(&mut self, origin: Vec3, scale: f32) {
+        self.position = (self.position - origin) * scale;
+        self.scaled *= scale * scale;
     }
 
     fn describe(&self) -> String {

@@ -3,7 +3,10 @@
 //! direction that covers the scene's bounding sphere (`center`, `radius`),
 //! outside it.
 
-use super::{aimed_across, directional_reach, disk_pdf, disk_point, Aim, Aimed, Emitted, Incident, Source};
+use super::{
+    aimed_across, directional_reach, disk_pdf, disk_point, Aim, Aimed, Emitted, Incident, MitsubaEmitter, MitsubaParam,
+    Source,
+};
 use crate::math::{Color, Frame, Ray, Vertex};
 use crate::sampling::{cosine_hemisphere, next_2d, uniform_cone, Rng};
 use glam::{Vec2, Vec3};
@@ -80,7 +83,14 @@ impl Source for Constant {
         (self.center, self.radius) = directional_reach(Vec3::ZERO, lo, hi);
     }
 
+    /// Light from infinity keeps its radiance where the scene moves.
+    fn moved(&mut self, _origin: Vec3, _scale: f32) {}
+
     fn describe(&self) -> String {
         "the constant sky".to_string()
+    }
+
+    fn mitsuba(&self) -> Result<MitsubaEmitter, String> {
+        Ok(MitsubaEmitter { plugin: "constant", params: vec![("radiance", MitsubaParam::Rgb(self.radiance))] })
     }
 }

@@ -1,7 +1,7 @@
 //! A spot light (Mitsuba's `spot`): a point emitting `intensity` (W/sr)
 //! into a cone, optionally through an image.
 
-use super::{aimed_from, Aim, Aimed, Emitted, Incident, Source};
+use super::{aimed_from, Aim, Aimed, Emitted, Incident, MitsubaEmitter, MitsubaParam, Source};
 use crate::math::{Color, Frame, Ray, Vertex};
 use crate::sampling::{uniform_cone, uniform_cone_pdf, Rng};
 use crate::texture::{SurfacePoint, Texture};
@@ -27,6 +27,9 @@ pub struct Spot {
     cos_cutoff: f32,
     cos_beam: f32,
     cutoff: f32,
+    /// The angles as given, in degrees.
+    cutoff_deg: f32,
+    beam_deg: f32,
     inv_transition: f32,
     /// ∫ falloff dω over the sphere: power is I times it.
     solid_angle: f32,
@@ -48,6 +51,8 @@ impl Spot {
             cos_cutoff: cutoff.cos(),
             cos_beam: beam.cos(),
             cutoff,
+            cutoff_deg,
+            beam_deg: beam_deg.min(cutoff_deg),
             inv_transition: 1.0 / (cutoff - beam),
             solid_angle: 0.0,
             pattern: None,
@@ -126,14 +131,6 @@ impl Spot {
             Some(_) => Color::ZERO,
         }
     }
-
-    pub fn cos_cutoff(&self) -> f32 {
-        self.cos_cutoff
-    }
-
-    pub fn beam_deg(&self) -> f32 {
-        self.cos_beam.clamp(-1.0, 1.0).acos().to_degrees()
-    }
 }
 
 impl Source for Spot {
@@ -184,11 +181,33 @@ impl Source for Spot {
         self.solid_angle() * self.intensity
     }
 
-    fn position(&self) -> Option<Vertex> {
-        Some(self.position)
+    fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        Some((self.position, self.position))
+    }
+
+    fn moved(&mut self, origin: Vec3, scale: f32) {
+        self.position = (self.position - origin) * scale;
+        self.intensity *= scale * scale;
     }
 
     fn describe(&self) -> String {
         format!("the spot light at {}", self.position)
+    }
+
+    fn mitsuba(&self) -> Result<MitsubaEmitter, String> {
+        if self.pattern.is_some() {
+            return Err("a spot light's texture: its export to Mitsuba 3 is not written yet".to_string());
+        }
+        let axis = self.frame.n;
+        let up = if axis.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
+        Ok(MitsubaEmitter {
+            plugin: "spot",
+            params: vec![
+                ("to_world", MitsubaParam::LookAt { origin: self.position, target: self.position + axis, up }),
+                ("intensity", MitsubaParam::Rgb(self.intensity)),
+                ("cutoff_angle", MitsubaParam::Float(self.cutoff_deg)),
+                ("beam_width", MitsubaParam::Float(self.beam_deg)),
+            ],
+        })
     }
 }

@@ -100,12 +100,12 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
 }
 
 /// A photon leaving its light: its ray, the departure and its power.
-type Emitted = (Ray, Option<Departure>, Color);
+pub type PhotonStart = (Ray, Option<Departure>, Color);
 
 /// Picks a light in proportion to its power (one light: always it) and
-/// starts a photon from it; for the caustic pass, also the target it was
-/// aimed at (whether or not the light could send it there).
-fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> (Option<usize>, Option<Emitted>) {
+/// starts photon `rng` of `n` from it; for the caustic pass, also the
+/// target it was aimed at (whether or not the light could send it there).
+pub fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> (Option<usize>, Option<PhotonStart>) {
     let Some((light, p_light)) = scene.pick_light(rng.random::<f32>()) else {
         return (None, None);
     };
@@ -418,8 +418,8 @@ mod tests {
     #[test]
     fn a_light_of_radiance_zero_emits_no_photons() {
         let mut parts = Scene::tncg15_parts(Eye::One);
-        let crate::scene::LightSpec::Area { radiance, .. } = &mut parts.lights[0] else { panic!() };
-        *radiance = crate::math::Color::ZERO;
+        let crate::light::Light::Area(a) = &mut parts.lights[0] else { panic!() };
+        a.radiance = crate::math::Color::ZERO;
         let scene = Scene::from_parts(parts);
         for pass in [Pass::Global, Pass::Caustic] {
             let out = trace_pass(&scene, pass, 1000, 1, &|_| {});

@@ -5,7 +5,7 @@
 
 use crate::accel::Accel;
 use crate::camera::Camera;
-use crate::light::{AreaLight, Emitting, Light};
+use crate::light::{AreaLight, Light};
 use crate::material::Material;
 use crate::math::{max_component, offset_ray_origin, Color, Frame, Ray, Vertex};
 use crate::sampling::Discrete;
@@ -20,7 +20,7 @@ pub mod vol;
 
 pub use room::{tncg15_room, Eye};
 
-use crate::shape::{Departure, Disk, Shape, ShapeHit, Triangle};
+use crate::shape::{Departure, Shape, ShapeHit};
 use glam::{Vec2, Vec3};
 
 /// One primitive: its geometry, the index of its material, and the object
@@ -190,8 +190,8 @@ pub struct Scene {
     /// (itself where two-sided); empty where every material is.
     back_material: Vec<u32>,
     pub paths: PathLimits,
-    background: Color,
-    envmap: Option<std::sync::Arc<crate::envmap::EnvMap>>,
+    /// The lights a ray leaving the scene meets (light from everywhere).
+    at_infinity: Vec<u32>,
     /// Textures and the materials that read them; `None` in a scene
     /// without textures, which then pays nothing for them.
     texturing: Option<Box<Texturing>>,
@@ -258,49 +258,6 @@ const NO_LIGHT: u32 = u32::MAX;
 /// one by one ([`Scene::many_lights`]).
 pub const MANY_LIGHTS: usize = 64;
 
-/// A light as a scene describes it, before the scene places it.
-#[derive(Clone, Debug)]
-pub enum LightSpec {
-    /// A one-sided Lambertian emitter; it becomes a primitive of the scene,
-    /// of `material` when it also reflects (a glowing wall), else a pure
-    /// emitter that absorbs what reaches it.
-    Area {
-        surface: Emitting,
-        radiance: Color,
-        material: Option<u32>,
-    },
-    Point {
-        position: Vertex,
-        intensity: Color,
-        falloff: f32,
-        dead_distance: f32,
-    },
-    /// Parallel light along unit `direction`.
-    Directional {
-        direction: Vec3,
-        irradiance: Color,
-    },
-    /// Radiance from every direction at infinity (Mitsuba's `constant`).
-    Constant {
-        radiance: Color,
-    },
-    /// A projector ([`crate::light::Projector`]).
-    Projector(crate::light::Projector),
-    /// An environment map at infinity ([`crate::envmap::EnvMap`]).
-    Envmap(std::sync::Arc<crate::envmap::EnvMap>),
-    /// A cone of light from `position` along unit `axis` ([`crate::light::Spot`]).
-    Spot {
-        position: Vertex,
-        axis: Vec3,
-        intensity: Color,
-        cutoff_deg: f32,
-        beam_deg: f32,
-        /// An image projected through the cone, with the spot's own x and
-        /// y axes (unit) that orient it.
-        pattern: Option<(std::sync::Arc<crate::texture::Texture>, Vec3, Vec3)>,
-    },
-}
-
 /// A scene's ingredients, before [`Scene::from_parts`] derives what the
 /// renderer needs from them.
 #[derive(Clone, Debug)]
@@ -309,7 +266,9 @@ pub struct SceneParts {
     /// Vertex normals of smooth triangles, indexed by their `shading`.
     pub shading_normals: Vec<[Vec3; 3]>,
     pub materials: Vec<Material>,
-    pub lights: Vec<LightSpec>,
+    /// The lights as the scene describes them; [`Scene::from_parts`]
+    /// places them.
+    pub lights: Vec<Light>,
     pub ambient: Color,
     pub camera: Camera,
     /// Per material: whether it reflects only on the front of the
@@ -337,31 +296,11 @@ impl SceneParts {
     /// The same scene with every length multiplied by `s` (> 0). Radiance is
     /// per unit area and solid angle, so the image is unchanged.
     pub fn scaled(mut self, s: f32) -> Self {
-        let scale_triangle = |t: Triangle| Triangle::new(t.v0 * s, t.v1 * s, t.v2 * s);
-        let scale_disk = |d: Disk| Disk { center: d.center * s, radius: d.radius * s, ..d };
         for p in &mut self.prims {
             p.shape = p.shape.scaled(s);
         }
         for l in &mut self.lights {
-            match l {
-                LightSpec::Area { surface: Emitting::Disk(d), .. } => *d = scale_disk(*d),
-                LightSpec::Area { surface: Emitting::Triangle(t), .. } => *t = scale_triangle(*t),
-                // Intensity (W/sr) gives irradiance I / d^2: keep the image by
-                // scaling it with the area.
-                LightSpec::Point { position, intensity, .. } => {
-                    *position *= s;
-                    *intensity *= s * s;
-                }
-                LightSpec::Directional { .. } | LightSpec::Constant { .. } | LightSpec::Envmap(_) => {}
-                LightSpec::Projector(p) => {
-                    p.position *= s;
-                    p.scaled *= s * s;
-                }
-                LightSpec::Spot { position, intensity, .. } => {
-                    *position *= s;
-                    *intensity *= s * s;
-                }
-            }
+            l.moved(Vec3::ZERO, s);
         }
         let shrink = glam::Affine3A::from_scale(Vec3::splat(1.0 / s));
         for f in &mut self.texturing.frames {
@@ -448,25 +387,17 @@ impl Scene {
         let mut prim_light = vec![NO_LIGHT; prims.len()];
         let mut lights = Vec::new();
         let emitter = materials.len() as u32;
-        if specs.iter().any(|l| matches!(l, LightSpec::Area { material: None, .. })) {
+        if specs.iter().any(|l| matches!(l, Light::Area(a) if a.material.is_none())) {
             materials.push(Material::Emitter);
         }
         let objects = prims.iter().map(|p| p.object + 1).max().unwrap_or(0);
         for (i, spec) in specs.iter().enumerate() {
-            if let LightSpec::Area { surface, radiance, material } = *spec {
+            if let Light::Area(a) = spec {
                 let prim = prims.len() as u32;
-                let material = material.unwrap_or(emitter);
-                let shape = match surface {
-                    Emitting::Disk(d) => Shape::Disk(d),
-                    Emitting::Triangle(t) => Shape::Triangle(t),
-                };
-                prims.push(Prim { shape, material, object: objects + lights.len() as u32 });
+                let material = a.material.unwrap_or(emitter);
+                prims.push(Prim { shape: a.surface.shape(), material, object: objects + lights.len() as u32 });
                 prim_light.push(lights.len() as u32);
-                let light = AreaLight::new(surface, radiance, prim);
-                lights.push(Light::Area(match light_patterns.get(i) {
-                    Some(Some(p)) => light.with_pattern(p.clone()),
-                    _ => light,
-                }));
+                lights.push(Light::Area(a.placed(prim, light_patterns.get(i).cloned().flatten())));
             }
         }
         let mut lo = Vec3::splat(f32::INFINITY);
@@ -476,64 +407,12 @@ impl Scene {
             lo = lo.min(a);
             hi = hi.max(b);
         }
-        for spec in &specs {
-            match *spec {
-                LightSpec::Area { .. } => {}
-                LightSpec::Point { position, intensity, falloff, dead_distance } => {
-                    lo = lo.min(position);
-                    hi = hi.max(position);
-                    lights.push(Light::Point(crate::light::PointLight { position, intensity, falloff, dead_distance }));
-                }
-                LightSpec::Directional { direction, irradiance } => {
-                    lights.push(Light::Directional(crate::light::Directional::new(direction, irradiance)));
-                }
-                LightSpec::Constant { radiance } => {
-                    lights.push(Light::Constant(crate::light::Constant::new(radiance)));
-                }
-                LightSpec::Envmap(ref map) => {
-                    lights.push(Light::Envmap(crate::light::Environment::new(map.clone())));
-                }
-                LightSpec::Projector(ref p) => {
-                    lo = lo.min(p.position);
-                    hi = hi.max(p.position);
-                    lights.push(Light::Projector(p.clone()));
-                }
-                LightSpec::Spot { position, axis, intensity, cutoff_deg, beam_deg, ref pattern } => {
-                    lo = lo.min(position);
-                    hi = hi.max(position);
-                    let spot = match pattern {
-                        None => {
-                            let frame = crate::math::Frame::from_normal(axis);
-                            crate::light::Spot::new(position, frame, intensity, cutoff_deg, beam_deg)
-                        }
-                        Some((texture, x, y)) => {
-                            let frame = crate::math::Frame { s: *x, t: *y, n: axis };
-                            crate::light::Spot::new(position, frame, intensity, cutoff_deg, beam_deg)
-                                .with_pattern(texture.clone())
-                        }
-                    };
-                    lights.push(Light::Spot(spot));
-                }
-            }
-        }
-        if !(lo.x <= hi.x) {
-            (lo, hi) = (Vec3::ZERO, Vec3::ZERO);
-        }
-        // Directional photons start outside everything else.
-        for l in &mut lights {
-            l.place(lo, hi);
-        }
-        let background = lights
-            .iter()
-            .map(|l| match l {
-                Light::Constant(c) => c.radiance,
-                _ => Color::ZERO,
-            })
-            .sum();
-        let envmap = lights.iter().find_map(|l| match l {
-            Light::Envmap(e) => Some(e.map.clone()),
-            _ => None,
-        });
+        lights.extend(specs.into_iter().filter(|l| l.area().is_none()));
+        // Light from infinity starts its photons outside everything else.
+        let (lo, hi) = crate::light::place_lights(&mut lights, lo, hi);
+        let at_infinity = (0..lights.len() as u32)
+            .filter(|&i| lights[i as usize].bounds().is_none() && !lights[i as usize].is_delta())
+            .collect();
         let targets = specular_targets(&prims, &materials);
         // Lights stay out of the enclosure: their hits must name them.
         let group: Vec<Option<u32>> =
@@ -555,8 +434,7 @@ impl Scene {
             light_pick,
             back_material,
             paths,
-            background,
-            envmap,
+            at_infinity,
             texturing,
         }
     }
@@ -565,10 +443,11 @@ impl Scene {
     /// scene (light from everywhere; black without it).
     #[inline]
     pub fn background(&self, dir: Vec3) -> Color {
-        match &self.envmap {
-            None => self.background,
-            Some(map) => self.background + map.eval(dir),
+        let mut sum = Color::ZERO;
+        for &i in &self.at_infinity {
+            sum += self.lights[i as usize].radiance_from_infinity(dir);
         }
+        sum
     }
 
     #[inline]

@@ -1,9 +1,9 @@
 //! The built-in default scene: the TNCG15 hexagonal room of
 //! notes/default-scene.md, number for number.
 
-use super::{LightSpec, Prim, Scene, SceneParts};
+use super::{Prim, Scene, SceneParts};
 use crate::camera::Camera;
-use crate::light::Emitting;
+use crate::light::{AreaLight, Emitting};
 use crate::material::Material;
 use crate::math::Color;
 use crate::shape::{tetrahedron, Disk, Shape, Sphere, Triangle};
@@ -124,11 +124,7 @@ impl Scene {
             prims,
             shading_normals: Vec::new(),
             materials,
-            lights: vec![LightSpec::Area {
-                surface: Emitting::Disk(light),
-                radiance: Color::splat(10.0),
-                material: None,
-            }],
+            lights: vec![AreaLight::unplaced(Emitting::Disk(light), Color::splat(10.0), None)],
             ambient: Color::ZERO,
             camera,
             one_sided: Vec::new(),

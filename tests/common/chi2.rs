@@ -8,7 +8,7 @@
 //! (cells - 1) degrees of freedom, is compared with a level Šidák-corrected
 //! for the number of tests a suite runs.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
 
 /// One χ² test's setting.
@@ -74,6 +74,44 @@ impl Chi2 {
             }
         }
         expected[nc * np] = ((1.0 - mass) * self.samples as f64).max(0.0);
+        self.pearson(&observed, &expected, mass)
+    }
+
+    /// As [`Self::run`] for a sampler of points of the unit square, binned
+    /// in `cos_bins` x `phi_bins` cells, against `pdf` (per unit area of
+    /// the square).
+    pub fn run_square(&self, mut sample: impl FnMut() -> Option<Vec2>, pdf: impl Fn(f64, f64) -> f64) -> Outcome {
+        let (nx, ny) = (self.cos_bins, self.phi_bins);
+        let mut observed = vec![0f64; nx * ny + 1];
+        for _ in 0..self.samples {
+            match sample() {
+                Some(p) => {
+                    let i = ((p.x.clamp(0.0, 1.0) as f64 * nx as f64) as usize).min(nx - 1);
+                    let j = ((p.y.clamp(0.0, 1.0) as f64 * ny as f64) as usize).min(ny - 1);
+                    observed[i * ny + j] += 1.0;
+                }
+                None => observed[nx * ny] += 1.0,
+            }
+        }
+        let mut expected = vec![0f64; nx * ny + 1];
+        let mut mass = 0.0;
+        for i in 0..nx {
+            for j in 0..ny {
+                let (x0, x1) = (i as f64 / nx as f64, (i + 1) as f64 / nx as f64);
+                let (y0, y1) = (j as f64 / ny as f64, (j + 1) as f64 / ny as f64);
+                let integral = simpson_2d(&pdf, x0, x1, y0, y1);
+                mass += integral;
+                expected[i * ny + j] = integral * self.samples as f64;
+            }
+        }
+        expected[nx * ny] = ((1.0 - mass) * self.samples as f64).max(0.0);
+        self.pearson(&observed, &expected, mass)
+    }
+
+    /// Pearson's test of `observed` counts against `expected` ones (the
+    /// same total), cells expecting fewer than 5 pooled; `mass` is
+    /// reported as the pdf's integral.
+    pub fn pearson(&self, observed: &[f64], expected: &[f64], mass: f64) -> Outcome {
         // Pool the cells expecting fewer than 5, smallest first, until the
         // pool itself expects 5 (or holds them all).
         let mut order: Vec<usize> = (0..expected.len()).collect();
@@ -96,6 +134,99 @@ impl Chi2 {
             statistic = f64::INFINITY;
         }
         let dof = cells.saturating_sub(1).max(1);
+        let p_value = if statistic.is_finite() { gamma_q(dof as f64 / 2.0, statistic / 2.0) } else { 0.0 };
+        let threshold = 1.0 - (1.0 - self.level).powf(1.0 / self.tests as f64);
+        Outcome { statistic, dof, p_value, threshold, pdf_mass: mass }
+    }
+
+    /// A test of weighted samples: `sample` returns a direction and its
+    /// weight, whose sum over a cell of the sphere must have the mean
+    /// `samples` times the integral of `density` over the cell (a photon's
+    /// direction and its power, against the light's radiant intensity).
+    pub fn run_weighted(
+        &self,
+        mut sample: impl FnMut() -> Option<(Vec3, f64)>,
+        density: impl Fn(Vec3) -> f64,
+    ) -> Outcome {
+        let (nc, np) = (self.cos_bins, self.phi_bins);
+        let integral = |k: usize| {
+            let (i, j) = (k / np, k % np);
+            let (c0, c1) = (-1.0 + 2.0 * i as f64 / nc as f64, -1.0 + 2.0 * (i + 1) as f64 / nc as f64);
+            let (p0, p1) = (2.0 * PI * j as f64 / np as f64, 2.0 * PI * (j + 1) as f64 / np as f64);
+            let f = |c: f64, phi: f64| {
+                let s = (1.0 - c * c).max(0.0).sqrt();
+                density(Vec3::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, c as f32))
+            };
+            simpson_2d(&f, c0, c1, p0, p1)
+        };
+        self.run_weighted_cells(nc * np, || sample().map(|(w, x)| (self.cell(w), x)), integral)
+    }
+
+    /// As [`Self::run_weighted`] for points of the unit square (`density`
+    /// per unit area of the square).
+    pub fn run_weighted_square(
+        &self,
+        mut sample: impl FnMut() -> Option<(Vec2, f64)>,
+        density: impl Fn(f64, f64) -> f64,
+    ) -> Outcome {
+        let (nx, ny) = (self.cos_bins, self.phi_bins);
+        let cell = |p: Vec2| {
+            let i = ((p.x.clamp(0.0, 1.0) as f64 * nx as f64) as usize).min(nx - 1);
+            let j = ((p.y.clamp(0.0, 1.0) as f64 * ny as f64) as usize).min(ny - 1);
+            i * ny + j
+        };
+        let integral = |k: usize| {
+            let (i, j) = ((k / ny) as f64, (k % ny) as f64);
+            simpson_2d(&density, i / nx as f64, (i + 1.0) / nx as f64, j / ny as f64, (j + 1.0) / ny as f64)
+        };
+        self.run_weighted_cells(nx * ny, || sample().map(|(p, x)| (cell(p), x)), integral)
+    }
+
+    /// The weighted test over `cells`: each cell's sum of weights against
+    /// `samples` times its `integral`, its deviation divided by the sum's
+    /// sampled variance (Σ w² less the mean's share); the sum of squares is
+    /// χ²-distributed on the number of cells (cells with fewer than 20
+    /// hits pooled). Weight where the density says none can be fails, as
+    /// does a large expected share where nothing came.
+    pub fn run_weighted_cells(
+        &self,
+        cells: usize,
+        mut sample: impl FnMut() -> Option<(usize, f64)>,
+        integral: impl Fn(usize) -> f64,
+    ) -> Outcome {
+        let (mut sum, mut sum2, mut hits) = (vec![0f64; cells], vec![0f64; cells], vec![0u64; cells]);
+        for _ in 0..self.samples {
+            if let Some((c, weight)) = sample() {
+                sum[c] += weight;
+                sum2[c] += weight * weight;
+                hits[c] += 1;
+            }
+        }
+        let n = self.samples as f64;
+        let (mut statistic, mut dof, mut mass) = (0.0, 0usize, 0.0);
+        let (mut pool_o, mut pool_e, mut pool_v, mut pool_hits) = (0.0, 0.0, 0.0, 0u64);
+        for k in 0..cells {
+            let integral = integral(k);
+            mass += integral;
+            let (o, e) = (sum[k], integral * n);
+            if e <= 0.0 && o > 0.0 {
+                statistic = f64::INFINITY;
+            }
+            let v = (sum2[k] - o * o / n).max(0.0);
+            if hits[k] >= 20 && v > 0.0 {
+                statistic += (o - e).powi(2) / v;
+                dof += 1;
+            } else {
+                (pool_o, pool_e, pool_v, pool_hits) = (pool_o + o, pool_e + e, pool_v + v, pool_hits + hits[k]);
+            }
+        }
+        if pool_hits >= 20 && pool_v > 0.0 {
+            statistic += (pool_o - pool_e).powi(2) / pool_v;
+            dof += 1;
+        } else if pool_e > 1e-3 * mass * n {
+            statistic = f64::INFINITY;
+        }
+        let dof = dof.max(1);
         let p_value = if statistic.is_finite() { gamma_q(dof as f64 / 2.0, statistic / 2.0) } else { 0.0 };
         let threshold = 1.0 - (1.0 - self.level).powf(1.0 / self.tests as f64);
         Outcome { statistic, dof, p_value, threshold, pdf_mass: mass }

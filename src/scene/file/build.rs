@@ -6,7 +6,7 @@ use super::locate::Source;
 use super::{SceneError, SceneFile};
 use crate::material::Material;
 use crate::math::Color;
-use crate::scene::{LightSpec, Prim, SceneParts};
+use crate::scene::{Prim, SceneParts};
 use glam::Vec3;
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -34,7 +34,7 @@ pub(super) struct Builder<'a> {
     pub(super) names: BTreeMap<String, u32>,
     pub(super) prims: Vec<Prim>,
     pub(super) shading_normals: Vec<[Vec3; 3]>,
-    pub(super) lights: Vec<LightSpec>,
+    pub(super) lights: Vec<crate::light::Light>,
     pub(super) not_physical: Vec<SceneError>,
     pub(super) meshes: Vec<std::path::PathBuf>,
     pub(super) origins: super::Origins,
@@ -187,30 +187,17 @@ impl<'a> Builder<'a> {
     /// give an area) are refused at the first, as a scene without light is
     /// refused: the image would be black, whatever the summary then blames.
     fn check_power(&self, ambient: Color) -> Result<(), SceneError> {
-        let (mut lo, mut hi) = (glam::DVec3::splat(f64::MAX), glam::DVec3::splat(f64::MIN));
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         for p in &self.prims {
             let (a, b) = p.shape.bounds();
-            lo = lo.min(a.as_dvec3());
-            hi = hi.max(b.as_dvec3());
+            lo = lo.min(a);
+            hi = hi.max(b);
         }
-        let reach = if lo.x <= hi.x { 0.5 * (hi - lo).length() } else { 0.0 };
-        let pi = std::f64::consts::PI;
-        let powers: Vec<f64> = self
-            .lights
-            .iter()
-            .map(|l| match *l {
-                LightSpec::Area { surface, radiance, .. } => {
-                    pi * surface.area() as f64 * radiance.as_dvec3().max_element()
-                }
-                LightSpec::Point { intensity, .. } | LightSpec::Spot { intensity, .. } => {
-                    4.0 * pi * intensity.as_dvec3().max_element()
-                }
-                LightSpec::Directional { irradiance, .. } => pi * reach * reach * irradiance.as_dvec3().max_element(),
-                LightSpec::Envmap(ref m) => pi * reach * reach * m.total().as_dvec3().max_element(),
-                LightSpec::Projector(ref p) => p.scaled.as_dvec3().max_element() * 4.0 * (p.tan_x * p.tan_y) as f64,
-                LightSpec::Constant { radiance } => 4.0 * pi * pi * reach * reach * radiance.as_dvec3().max_element(),
-            })
-            .collect();
+        // Each light's power as the renderer sees it, placed as the scene
+        // places it.
+        let mut lights = self.lights.clone();
+        crate::light::place_lights(&mut lights, lo, hi);
+        let powers: Vec<f64> = lights.iter().map(|l| l.power().max_element() as f64).collect();
         let total: f64 = powers.iter().sum();
         // The renderer carries power in single precision: below its
         // smallest normal number a light is dark.
@@ -233,10 +220,11 @@ impl<'a> Builder<'a> {
         Err(self.origins.error(
             &place,
             format!(
-                "emits {:.3e} W ({total:.3e} W from all lights), more than single precision carries through \
-                 photon and pixel sums (at most {MAX_POWER:e} W); lower its radiance and raise --exposure \
-                 instead (images are linear)",
-                powers[brightest]
+                "emits {} ({} from all lights), more than single precision carries through photon and pixel \
+                 sums (at most {MAX_POWER:e} W); lower its radiance and raise --exposure instead (images are \
+                 linear)",
+                watts(powers[brightest]),
+                watts(total)
             ),
         ))
     }
@@ -245,5 +233,15 @@ impl<'a> Builder<'a> {
     fn place(&self, span: Range<usize>, field: String) -> super::Place {
         let e = self.src.error(span, field, "");
         super::Place { line: e.line, column: e.column, field: e.field }
+    }
+}
+
+/// A power for a message: single precision's power beyond its range is
+/// only "more than" it.
+fn watts(p: f64) -> String {
+    if p.is_finite() {
+        format!("{p:.3e} W")
+    } else {
+        format!("more than {:.3e} W", f32::MAX)
     }
 }

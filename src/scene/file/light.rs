@@ -3,8 +3,7 @@
 use super::build::{at, Builder};
 use super::defs::{Entry, V3};
 use super::SceneError;
-use crate::light::Emitting;
-use crate::scene::LightSpec;
+use crate::light::{AreaLight, Directional, Emitting, Light};
 use crate::shape::Disk;
 use serde::Deserialize;
 use toml::Spanned;
@@ -47,7 +46,7 @@ impl Builder<'_> {
                 let normal = self.direction(&at(&d.normal, f("normal")))?;
                 let radius = self.number(&at(&d.radius, f("radius")), 0.0, f32::INFINITY, true)?;
                 let radiance = self.color(&at(&d.radiance, f("radiance")))?;
-                LightSpec::Area { surface: Emitting::Disk(Disk { center, normal, radius }), radiance, material: None }
+                AreaLight::unplaced(Emitting::Disk(Disk { center, normal, radius }), radiance, None)
             }
             "point" => {
                 let d: PointLight = entry.read(&self.src)?;
@@ -72,13 +71,13 @@ impl Builder<'_> {
                         ),
                     ));
                 }
-                LightSpec::Point { position, intensity, falloff, dead_distance }
+                Light::Point(crate::light::PointLight { position, intensity, falloff, dead_distance })
             }
             "directional" => {
                 let d: DirectionalLight = entry.read(&self.src)?;
                 let direction = self.direction(&at(&d.direction, f("direction")))?;
                 let irradiance = self.color(&at(&d.color, f("color")))?;
-                LightSpec::Directional { direction, irradiance }
+                Light::Directional(Directional::new(direction, irradiance))
             }
             other => {
                 let kind = entry.kind();

@@ -3,10 +3,10 @@
 use super::build::{at, At, Builder};
 use super::defs::{Entry, V3};
 use super::SceneError;
-use crate::light::Emitting;
+use crate::light::{AreaLight, Emitting};
 use crate::math::Color;
 use crate::scene::mesh::load_obj;
-use crate::scene::{tncg15_room, LightSpec, Prim};
+use crate::scene::{tncg15_room, Prim};
 use crate::shape::{tetrahedron, Disk, Ellipsoid, Shape, Sphere, Triangle};
 use glam::{Affine3A, Vec3};
 use serde::Deserialize;
@@ -300,7 +300,7 @@ impl Builder<'_> {
                 };
                 let place = self.origins.objects[i].clone();
                 for t in kept {
-                    self.lights.push(LightSpec::Area { surface: Emitting::Triangle(t), radiance, material });
+                    self.lights.push(AreaLight::unplaced(Emitting::Triangle(t), radiance, material));
                     self.origins.lights.push(place.clone());
                 }
             }

@@ -7,9 +7,10 @@
 use super::props::{Plugin, Value};
 use super::spectrum::Use;
 use super::Builder;
+use crate::light::{Constant, Directional, Environment, Light, PointLight, Spot};
 use crate::math::Color;
+use crate::math::Frame;
 use crate::scene::file::SceneError;
-use crate::scene::LightSpec;
 use glam::{DAffine3, DVec3};
 
 impl Builder<'_> {
@@ -28,7 +29,7 @@ impl Builder<'_> {
 
 impl Builder<'_> {
     /// An environment map from a latitude-longitude EXR.
-    fn envmap(&mut self, p: &Plugin) -> Result<LightSpec, SceneError> {
+    fn envmap(&mut self, p: &Plugin) -> Result<Light, SceneError> {
         let (name, loc) = p.string("filename")?.ok_or_else(|| p.refuse("an envmap needs a filename"))?;
         let scale = p.float_in("scale", 1.0, 0.0, 1e30)?;
         let m = p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
@@ -55,7 +56,11 @@ impl Builder<'_> {
             return Err(p.fail(p.loc(), "to_world", "an environment map's transform must be a rotation"));
         }
         let to_world = r.as_mat3();
-        Ok(LightSpec::Envmap(std::sync::Arc::new(crate::envmap::EnvMap::new(&image, scale as f32, to_world))))
+        Ok(Light::Envmap(Environment::new(std::sync::Arc::new(crate::envmap::EnvMap::new(
+            &image,
+            scale as f32,
+            to_world,
+        )))))
     }
 }
 
@@ -72,7 +77,7 @@ impl Builder<'_> {
         }
     }
 
-    fn light_of(&mut self, p: &Plugin) -> Result<LightSpec, SceneError> {
+    fn light_of(&mut self, p: &Plugin) -> Result<Light, SceneError> {
         let spec = match p.kind {
             "point" => {
                 let position = match (p.point("position")?, p.transform("to_world")?) {
@@ -82,7 +87,7 @@ impl Builder<'_> {
                 };
                 let intensity = p.color("intensity", Use::Emission)?.unwrap_or(Color::ONE);
                 p.finish("position, to_world, intensity")?;
-                LightSpec::Point { position: position.as_vec3(), intensity, falloff: 2.0, dead_distance: 0.0 }
+                Light::Point(PointLight { position: position.as_vec3(), intensity, falloff: 2.0, dead_distance: 0.0 })
             }
             "directional" => {
                 let direction = match (p.point("direction")?, p.transform("to_world")?) {
@@ -96,7 +101,7 @@ impl Builder<'_> {
                     .as_vec3();
                 let irradiance = p.color("irradiance", Use::Emission)?.unwrap_or(Color::ONE);
                 p.finish("direction, to_world, irradiance")?;
-                LightSpec::Directional { direction, irradiance }
+                Light::Directional(Directional::new(direction, irradiance))
             }
             "spot" => {
                 let m = p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
@@ -123,14 +128,15 @@ impl Builder<'_> {
                         Some((t, x.as_vec3(), axis.cross(x).as_vec3()))
                     }
                 };
-                LightSpec::Spot {
-                    position: m.translation.as_vec3(),
-                    axis: axis.as_vec3(),
-                    intensity,
-                    cutoff_deg: cutoff as f32,
-                    beam_deg: beam.min(cutoff) as f32,
-                    pattern,
-                }
+                let (position, axis) = (m.translation.as_vec3(), axis.as_vec3());
+                let (cutoff, beam) = (cutoff as f32, beam.min(cutoff) as f32);
+                Light::Spot(match pattern {
+                    None => Spot::new(position, Frame::from_normal(axis), intensity, cutoff, beam),
+                    Some((texture, x, y)) => {
+                        Spot::new(position, Frame { s: x, t: y, n: axis }, intensity, cutoff, beam)
+                            .with_pattern(texture)
+                    }
+                })
             }
             "projector" => {
                 let m = p.transform("to_world")?.unwrap_or(DAffine3::IDENTITY);
@@ -162,7 +168,7 @@ impl Builder<'_> {
                     let mean = crate::light::Projector::window_mean(&t);
                     (t, mean)
                 });
-                LightSpec::Projector(crate::light::Projector {
+                Light::Projector(crate::light::Projector {
                     position: m.translation.as_vec3(),
                     axes: [axes[0], axes[1], axes[2]],
                     scaled: irradiance * (std::f32::consts::PI * scale as f32),
@@ -175,7 +181,7 @@ impl Builder<'_> {
             "constant" => {
                 let radiance = p.color("radiance", Use::Emission)?.unwrap_or(Color::ONE);
                 p.finish("radiance")?;
-                LightSpec::Constant { radiance }
+                Light::Constant(Constant::new(radiance))
             }
             k => {
                 return Err(p.refuse(format!(
@@ -183,9 +189,9 @@ impl Builder<'_> {
                 )))
             }
         };
-        if let LightSpec::Point { intensity: c, .. }
-        | LightSpec::Spot { intensity: c, .. }
-        | LightSpec::Directional { irradiance: c, .. } = spec
+        if let Light::Point(PointLight { intensity: c, .. })
+        | Light::Spot(Spot { intensity: c, .. })
+        | Light::Directional(Directional { irradiance: c, .. }) = &spec
         {
             if c.min_element() < 0.0 {
                 return Err(p.refuse("emission must not be negative"));

@@ -30,7 +30,7 @@ mod textures;
 pub mod xml;
 
 use super::file::{Origins, Place, SceneError, SceneFile};
-use super::{LightSpec, Prim, SceneParts};
+use super::{Prim, SceneParts};
 use crate::camera::Camera;
 use crate::material::Material;
 use crate::math::Color;
@@ -216,7 +216,7 @@ struct Builder<'a> {
     material_cache: Vec<(*const xml::Element, u32)>,
     prims: Vec<Prim>,
     shading_normals: Vec<[Vec3; 3]>,
-    lights: Vec<LightSpec>,
+    lights: Vec<crate::light::Light>,
     origins: Origins,
     inputs: Vec<PathBuf>,
     substitutions: Vec<String>,

@@ -16,13 +16,13 @@
 use super::props::{Plugin, Value};
 use super::spectrum::Use;
 use super::Builder;
-use crate::light::Emitting;
+use crate::light::{AreaLight, Emitting};
 use crate::math::Color;
 use crate::scene::file::SceneError;
 use crate::scene::mesh::load_obj;
 use crate::scene::ply::load_ply;
 use crate::scene::serialized::load_serialized;
-use crate::scene::{LightSpec, Prim};
+use crate::scene::Prim;
 use crate::shape::{Cylinder, Disk, Ellipse, Ellipsoid, Normals, SdfGrid, Shape, Sphere, Triangle};
 use crate::texture::SurfaceUv;
 use glam::{Affine3A, DAffine3, DVec3, Vec2, Vec3};
@@ -275,7 +275,7 @@ impl Builder<'_> {
                 }
                 (Some(radiance), Shape::Disk(d)) => {
                     self.origins.lights.push(super::place(p));
-                    self.lights.push(LightSpec::Area { surface: Emitting::Disk(d), radiance, material: Some(material) })
+                    self.lights.push(AreaLight::unplaced(Emitting::Disk(d), radiance, Some(material)))
                 }
                 (Some(_), _) => {
                     return Err(p.refuse(format!(
@@ -334,11 +334,7 @@ impl Builder<'_> {
                     self.light_patterns.resize(self.lights.len(), None);
                     self.light_patterns.push(Some(std::sync::Arc::new(pattern)));
                 }
-                self.lights.push(LightSpec::Area {
-                    surface: Emitting::Triangle(t),
-                    radiance,
-                    material: Some(material),
-                });
+                self.lights.push(AreaLight::unplaced(Emitting::Triangle(t), radiance, Some(material)));
                 continue;
             }
             if let Some(n) = n.filter(|n| n.iter().all(|c| c.length_squared() > 0.0)) {
