@@ -99,12 +99,32 @@ fn suite_08_hall() {
     check("08-hall");
 }
 
+#[test]
+fn suite_09_frosted_glass() {
+    check("09-frosted-glass");
+}
+
+#[test]
+fn suite_10_gold_glass() {
+    check("10-gold-glass");
+}
+
 /// Every reference the manifest names loads, with its noise, and a
 /// caustic window's own reference has the window's size.
 #[test]
 fn the_manifest_references_load_and_fit_their_windows() {
     let suite = photonmap::suite::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/suite")).unwrap();
-    assert_eq!(suite.len(), 8);
+    // Every scene file beside the manifest is in it.
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/suite");
+    let mut files: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|f| f.ends_with(".toml") && f != "suite.toml")
+        .collect();
+    files.sort();
+    let mut listed: Vec<String> = suite.iter().map(|s| format!("{}.toml", s.name)).collect();
+    listed.sort();
+    assert_eq!(files, listed);
     for s in &suite {
         let reference = s.load_reference().unwrap();
         assert!(s.caustic.rows.1 <= reference.height && s.caustic.cols.1 <= reference.width, "{}", s.name);

@@ -10,7 +10,9 @@
 # box's 16384, the hall's 65536 and the small light's 40960: at 8192 their
 # noise was larger than photonmap's error after a minute. The last two
 # were extended: a second render with other seeds merged with the first's
-# halves, tools/mitsuba_reference.py --add)
+# halves, tools/mitsuba_reference.py --add; the frosted glass's and the
+# gold and glass's were rendered with VARIANT=cuda_ad_rgb on an NVIDIA
+# H100: 1048576 and 2097152 spp, their windows 4194304 and 16777216)
 # Needs Mitsuba 3.9.1 in a Python (MITSUBA_PYTHON, default python3) and, for
 # the llvm variant, DRJIT_LIBLLVM_PATH (see tools/mitsuba_reference.py).
 # Hours of CPU: run it by hand, not in CI.
@@ -43,6 +45,8 @@ scenes=(
   "06-water-glass caustic=115:156,95:175"
   "07-million caustic=100:141,94:135"
   "08-hall caustic=96:128,72:128 --origin 20,9.75,1.05 --scale 100"
+  "09-frosted-glass caustic=120:142,86:128"
+  "10-gold-glass caustic=121:134,134:152"
 )
 for entry in "${scenes[@]}"; do
   read -r name window placement <<<"$entry"
@@ -50,14 +54,14 @@ for entry in "${scenes[@]}"; do
   # shellcheck disable=SC2086 # the placement is words
   ./target/release/photonmap export --mitsuba "scenes/suite/$name.toml" "$work/$name.xml" ${placement:-}
   "$py" tools/mitsuba_reference.py "$work/$name.xml" "$out/$name.exr" --width 200 --height 200 \
-    --spp "$spp" --passes 16 --window "$window" --keep-halves "$work"
+    --spp "$spp" --passes "${PASSES:-16}" --window "$window" --keep-halves "$work" --variant "${VARIANT:-llvm_ad_rgb}"
   # The caustic window alone with many more samples (CROP_SPP, default
   # 262144), where suite.toml names it (caustic_reference): the window's
   # error is measurable below the whole reference's noise, at a fraction
   # of the whole image's cost (its pixels are ~4% of the image's).
   if grep -q "$name-caustic.exr" scenes/suite/suite.toml; then
     "$py" tools/mitsuba_reference.py "$work/$name.xml" "$out/$name-caustic.exr" --width 200 --height 200 \
-      --spp "${CROP_SPP:-262144}" --passes 16 --crop "${window#caustic=}"
+      --spp "${CROP_SPP:-262144}" --passes "${PASSES:-16}" --crop "${window#caustic=}" --variant "${VARIANT:-llvm_ad_rgb}"
   fi
 done
 echo "halves kept in $work"
