@@ -15,7 +15,7 @@
 use super::conductor::RoughConductor;
 use super::dielectric::RoughDielectric;
 use super::plastic::RoughPlastic;
-use super::{Phong, Transport};
+use super::{Phong, Principled, PrincipledThin, Transport};
 use crate::math::Color;
 use crate::sampling::{next_2d, Rng};
 use glam::Vec3;
@@ -33,6 +33,10 @@ pub enum Glossy<'a> {
     Dielectric(&'a RoughDielectric),
     /// A rough plastic's coat (its diffuse base is the material's diffuse lobe).
     Coat(&'a RoughPlastic),
+    /// A principled BSDF's main reflection, transmission and clearcoat.
+    Principled(&'a Principled),
+    /// A thin principled BSDF's specular lobes and diffuse transmission.
+    Thin(&'a PrincipledThin),
 }
 
 impl Glossy<'_> {
@@ -44,6 +48,8 @@ impl Glossy<'_> {
             Glossy::Conductor(c) => c.eval(wo, wi),
             Glossy::Dielectric(d) => d.eval(wo, wi, entering, mode),
             Glossy::Coat(p) => p.eval_coat(wo, wi),
+            Glossy::Principled(p) => p.eval_glossy(wo, wi, mode),
+            Glossy::Thin(p) => p.eval_glossy(wo, wi),
         }
     }
 
@@ -55,6 +61,8 @@ impl Glossy<'_> {
             Glossy::Conductor(c) => c.pdf(wo, wi),
             Glossy::Dielectric(d) => d.pdf(wo, wi, entering),
             Glossy::Coat(p) => p.coat_pdf(wo, wi),
+            Glossy::Principled(p) => p.glossy_pdf(wo, wi),
+            Glossy::Thin(p) => p.glossy_pdf(wo, wi),
         }
     }
 
@@ -70,6 +78,14 @@ impl Glossy<'_> {
                 d.sample(wo, entering, mode, u1, next_2d(rng))
             }
             Glossy::Coat(p) => p.sample_coat(wo, next_2d(rng)),
+            Glossy::Principled(p) => {
+                let u1 = rng.random::<f32>();
+                p.sample_glossy(wo, mode, u1, next_2d(rng))
+            }
+            Glossy::Thin(p) => {
+                let u1 = rng.random::<f32>();
+                p.sample_glossy(wo, u1, next_2d(rng))
+            }
         }
     }
 
@@ -94,12 +110,19 @@ impl Glossy<'_> {
             Glossy::Conductor(c) => c.microfacet.roughness(),
             Glossy::Dielectric(d) => d.microfacet.roughness(),
             Glossy::Coat(p) => p.microfacet.roughness(),
+            Glossy::Principled(p) => p.microfacet().roughness(),
+            Glossy::Thin(p) => p.microfacet().roughness(),
         };
         roughness < CAUSTIC_ROUGHNESS
     }
 
     /// Whether the lobe lets light through the surface.
     pub fn transmits(&self) -> bool {
-        matches!(self, Glossy::Dielectric(_))
+        match self {
+            Glossy::Dielectric(_) => true,
+            Glossy::Principled(p) => p.transmits(),
+            Glossy::Thin(p) => p.transmits(),
+            _ => false,
+        }
     }
 }

@@ -19,6 +19,8 @@ impl Material {
             Material::Plastic(p) => p.albedo_bound(wo),
             Material::RoughPlastic(p) => p.albedo_bound(wo),
             Material::Masked(m) => (max_component(m.rho()) + m.through()).min(1.0),
+            Material::Principled(p) => p.albedo_bound(wo),
+            Material::PrincipledThin(p) => p.albedo_bound(wo),
             _ => 1.0,
         }
     }
@@ -29,6 +31,8 @@ impl Material {
             Material::Plastic(p) => p.diffuse_albedo(wo),
             Material::RoughPlastic(p) => p.diffuse_albedo(wo),
             Material::Masked(m) => m.rho(),
+            Material::Principled(p) => p.diffuse_albedo(wo),
+            Material::PrincipledThin(p) => p.diffuse_albedo(wo),
             _ => Color::ZERO,
         }
     }
@@ -37,6 +41,8 @@ impl Material {
     pub(super) fn mitsuba_eval(&self, wo: Vec3, wi: Vec3, entering: bool, mode: Transport) -> Color {
         match self {
             Material::RoughDielectric(d) => d.eval(wo, wi, entering, mode),
+            Material::Principled(p) => p.eval(wo, wi, mode),
+            Material::PrincipledThin(p) => p.eval(wo, wi),
             _ if !(wi.z > 0.0) => Color::ZERO,
             Material::RoughConductor(c) => c.eval(wo, wi),
             Material::Plastic(p) => p.eval(wo, wi),
@@ -54,6 +60,8 @@ impl Material {
             Material::Plastic(p) => p.pdf(wo, wi),
             Material::RoughPlastic(p) => p.pdf(wo, wi),
             Material::Masked(m) => m.opacity * crate::sampling::cosine_hemisphere_pdf(wi),
+            Material::Principled(p) => p.pdf(wo, wi),
+            Material::PrincipledThin(p) => p.pdf(wo, wi),
             _ => 0.0,
         }
     }
@@ -125,6 +133,16 @@ impl Material {
                 let u1 = rng.random::<f32>();
                 let (wi, coat, weight) = p.sample(wo, u1, next_2d(rng))?;
                 Some(Scatter { wi, weight, lobe: if coat { Lobe::Glossy } else { Lobe::Diffuse } })
+            }
+            Material::Principled(p) => {
+                let u1 = rng.random::<f32>();
+                let (wi, weight, diffuse) = p.sample(wo, mode, u1, next_2d(rng))?;
+                Some(Scatter { wi, weight, lobe: if diffuse { Lobe::Diffuse } else { Lobe::Glossy } })
+            }
+            Material::PrincipledThin(p) => {
+                let u1 = rng.random::<f32>();
+                let (wi, weight, diffuse) = p.sample(wo, u1, next_2d(rng))?;
+                Some(Scatter { wi, weight, lobe: if diffuse { Lobe::Diffuse } else { Lobe::Glossy } })
             }
             _ => None,
         }

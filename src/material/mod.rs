@@ -32,6 +32,8 @@
 //! | `thindielectric` | [`Material::thin_dielectric`]`(int_ior, ext_ior, specular_reflectance, specular_transmittance)` |
 //! | `plastic` | [`Material::plastic`]`(diffuse_reflectance, specular_reflectance, int_ior, ext_ior, nonlinear)` |
 //! | `roughplastic` | [`Material::rough_plastic`]`(distribution, alpha, diffuse_reflectance, specular_reflectance, int_ior, ext_ior, nonlinear)` |
+//! | `principled` | [`Material::Principled`]`(`[`Principled`]`)` |
+//! | `principledthin` | [`Material::PrincipledThin`]`(`[`PrincipledThin`]`)` |
 //!
 //! Isotropic roughness is `alpha_u = alpha_v = alpha`; anisotropic alpha_u
 //! runs along the first tangent of the shading frame (`math::Frame`, built
@@ -40,12 +42,15 @@
 
 mod conductor;
 mod dielectric;
+pub mod disney;
 mod glossy;
 mod mask;
 pub mod microfacet;
 mod mitsuba;
 mod phong;
 mod plastic;
+mod principled;
+mod principled_thin;
 mod textured;
 
 pub use conductor::{Conductor, RoughConductor};
@@ -55,7 +60,9 @@ pub use mask::Masked;
 pub use microfacet::{Distribution, Microfacet};
 pub use phong::Phong;
 pub use plastic::{fresnel_diffuse_reflectance, Plastic, RoughPlastic};
-pub use textured::{Param, Textured};
+pub use principled::Principled;
+pub use principled_thin::PrincipledThin;
+pub use textured::{Param, PrincipledRecipe, Textured, ThinRecipe};
 
 use crate::math::{max_component, Color};
 use crate::optics::{fresnel_dielectric, reflect, refract};
@@ -110,6 +117,11 @@ pub enum Material {
     RoughPlastic(RoughPlastic),
     /// A diffuse surface cut out by an opacity ([`Masked`]).
     Masked(Masked),
+    /// Mitsuba's principled BSDF (Burley's Disney BSDF); one-sided: its
+    /// back ([`Material::back_side`]) keeps the specular lobes alone.
+    Principled(Principled),
+    /// Mitsuba's thin principled BSDF: a sheet, the same from both sides.
+    PrincipledThin(PrincipledThin),
     /// A light's own surface: it emits (through its light) and reflects nothing.
     Emitter,
 }
@@ -270,6 +282,7 @@ impl Material {
     pub fn back_side(&self) -> Material {
         match *self {
             Material::Masked(m) => Material::Masked(Masked { rho: Color::ZERO, ..m }),
+            Material::Principled(p) => Material::Principled(Principled { back: true, ..p }),
             _ => Material::Lambertian { rho: Color::ZERO },
         }
     }
@@ -295,9 +308,11 @@ impl Material {
             Material::Phong(p) => max_component(p.mirror_rho()) > 0.0,
             Material::Plastic(p) => max_component(p.specular) > 0.0,
             Material::Masked(m) => m.through() > 0.0,
-            Material::RoughConductor(_) | Material::RoughDielectric(_) | Material::RoughPlastic(_) => {
-                self.glossy().is_some_and(|g| g.carries_caustics())
-            }
+            Material::RoughConductor(_)
+            | Material::RoughDielectric(_)
+            | Material::RoughPlastic(_)
+            | Material::Principled(_)
+            | Material::PrincipledThin(_) => self.glossy().is_some_and(|g| g.carries_caustics()),
             m => m.is_specular(),
         }
     }
@@ -314,6 +329,8 @@ impl Material {
             Material::Plastic(p) => p.diffuse,
             Material::RoughPlastic(p) => p.diffuse,
             Material::Masked(m) => m.rho(),
+            Material::Principled(p) => return p.diffuse_rho(),
+            Material::PrincipledThin(p) => return p.diffuse_rho(),
             _ => return None,
         };
         (max_component(rho) > 0.0).then_some(rho)
@@ -330,7 +347,10 @@ impl Material {
         match self {
             Material::Lambertian { rho } => *rho,
             Material::Phong(p) => p.diffuse_rho(),
-            Material::Plastic(_) | Material::RoughPlastic(_) => self.mitsuba_diffuse_albedo(wo),
+            Material::Plastic(_)
+            | Material::RoughPlastic(_)
+            | Material::Principled(_)
+            | Material::PrincipledThin(_) => self.mitsuba_diffuse_albedo(wo),
             Material::Masked(m) => m.rho(),
             _ => Color::ZERO,
         }
@@ -344,6 +364,8 @@ impl Material {
             Material::RoughConductor(c) => Some(Glossy::Conductor(c)),
             Material::RoughDielectric(d) => Some(Glossy::Dielectric(d)),
             Material::RoughPlastic(p) if max_component(p.specular) > 0.0 => Some(Glossy::Coat(p)),
+            Material::Principled(p) if p.has_glossy() => Some(Glossy::Principled(p)),
+            Material::PrincipledThin(p) if p.has_glossy() => Some(Glossy::Thin(p)),
             _ => None,
         }
     }
@@ -352,7 +374,12 @@ impl Material {
     /// sought on both sides).
     #[inline]
     pub fn transmits(&self) -> bool {
-        matches!(self, Material::RoughDielectric(_))
+        match self {
+            Material::RoughDielectric(_) => true,
+            Material::Principled(p) => p.transmits(),
+            Material::PrincipledThin(p) => p.transmits(),
+            _ => false,
+        }
     }
 
     /// Whether the material has a diffuse or glossy lobe (light arriving

@@ -4,7 +4,8 @@
 //! scenes that use textures are built this way; the rest are plain
 //! materials from the start.
 
-use super::{Distribution, Material};
+use super::disney::Rates;
+use super::{Distribution, Material, Principled, PrincipledThin};
 use crate::math::Color;
 use crate::texture::{SurfacePoint, Texture};
 
@@ -103,6 +104,79 @@ pub enum Textured {
         ext_ior: f32,
         nonlinear: bool,
     },
+    Principled(PrincipledRecipe),
+    PrincipledThin(ThinRecipe),
+}
+
+/// Mitsuba's `principled`: every parameter a texture may give, but the
+/// index and the sampling rates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrincipledRecipe {
+    pub base_color: Param,
+    pub roughness: Param,
+    pub anisotropic: Param,
+    pub metallic: Param,
+    pub spec_trans: Param,
+    pub spec_tint: Param,
+    pub sheen: Param,
+    pub sheen_tint: Param,
+    pub flatness: Param,
+    pub clearcoat: Param,
+    pub clearcoat_gloss: Param,
+    pub eta: f32,
+    pub rates: Rates,
+}
+
+/// Mitsuba's `principledthin`: every parameter a texture may give (its
+/// index too), but the sampling rates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ThinRecipe {
+    pub base_color: Param,
+    pub roughness: Param,
+    pub anisotropic: Param,
+    pub spec_trans: Param,
+    pub eta: Param,
+    pub spec_tint: Param,
+    pub sheen: Param,
+    pub sheen_tint: Param,
+    pub flatness: Param,
+    pub diff_trans: Param,
+    pub rates: Rates,
+}
+
+impl PrincipledRecipe {
+    fn params(&self) -> [Param; 11] {
+        [
+            self.base_color,
+            self.roughness,
+            self.anisotropic,
+            self.metallic,
+            self.spec_trans,
+            self.spec_tint,
+            self.sheen,
+            self.sheen_tint,
+            self.flatness,
+            self.clearcoat,
+            self.clearcoat_gloss,
+        ]
+    }
+}
+
+impl ThinRecipe {
+    fn params(&self) -> [Param; 10] {
+        [
+            self.base_color,
+            self.roughness,
+            self.anisotropic,
+            self.spec_trans,
+            self.eta,
+            self.spec_tint,
+            self.sheen,
+            self.sheen_tint,
+            self.flatness,
+            self.diff_trans,
+        ]
+    }
 }
 
 impl Textured {
@@ -120,6 +194,8 @@ impl Textured {
             Textured::Plastic { diffuse, specular, .. } | Textured::RoughPlastic { diffuse, specular, .. } => {
                 &[*diffuse, *specular]
             }
+            Textured::Principled(r) => return r.params().iter().any(|p| p.is_texture()),
+            Textured::PrincipledThin(r) => return r.params().iter().any(|p| p.is_texture()),
         };
         params.iter().any(|p| p.is_texture())
     }
@@ -139,6 +215,9 @@ impl Textured {
     fn build(&self, color: impl Fn(Param) -> Color, number: impl Fn(Param) -> f32) -> Material {
         let unit = |p: Param| color(p).clamp(Color::ZERO, Color::ONE);
         let alpha = |p: Param| number(p).clamp(0.0, 10.0);
+        // Mitsuba documents the principled BSDFs' weights on [0, 1] (the
+        // diffuse transmission on [0, 2]); an image outside is held there.
+        let weight = |p: Param| number(p).clamp(0.0, 1.0);
         match *self {
             Textured::Diffuse { reflectance } => Material::Lambertian { rho: unit(reflectance) },
             Textured::Mask { opacity, reflectance } => {
@@ -175,6 +254,35 @@ impl Textured {
             Textured::RoughPlastic { distribution, alpha, diffuse, specular, int_ior, ext_ior, nonlinear } => {
                 Material::rough_plastic(distribution, alpha, unit(diffuse), unit(specular), int_ior, ext_ior, nonlinear)
             }
+            Textured::Principled(ref r) => Material::Principled(Principled {
+                base_color: unit(r.base_color),
+                roughness: weight(r.roughness),
+                anisotropic: weight(r.anisotropic),
+                metallic: weight(r.metallic),
+                spec_trans: weight(r.spec_trans),
+                eta: r.eta,
+                spec_tint: weight(r.spec_tint),
+                sheen: weight(r.sheen),
+                sheen_tint: weight(r.sheen_tint),
+                flatness: weight(r.flatness),
+                clearcoat: weight(r.clearcoat),
+                clearcoat_gloss: weight(r.clearcoat_gloss),
+                rates: r.rates,
+                back: false,
+            }),
+            Textured::PrincipledThin(ref r) => Material::PrincipledThin(PrincipledThin {
+                base_color: unit(r.base_color),
+                roughness: weight(r.roughness),
+                anisotropic: weight(r.anisotropic),
+                spec_trans: weight(r.spec_trans),
+                eta: number(r.eta).clamp(1e-3, 100.0),
+                spec_tint: weight(r.spec_tint),
+                sheen: weight(r.sheen),
+                sheen_tint: weight(r.sheen_tint),
+                flatness: weight(r.flatness),
+                diff_trans: number(r.diff_trans).clamp(0.0, 2.0),
+                rates: r.rates,
+            }),
         }
     }
 }

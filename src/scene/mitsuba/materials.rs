@@ -45,7 +45,7 @@ impl Builder<'_> {
     }
 
     /// A reflectance: a colour within [0, 1] or a texture.
-    fn reflectance(&mut self, p: &Plugin, name: &str, default: f32) -> Result<Param, SceneError> {
+    pub(super) fn reflectance(&mut self, p: &Plugin, name: &str, default: f32) -> Result<Param, SceneError> {
         let param = self.param(p, name, Use::Reflectance, Color::splat(default))?;
         if let Param::Fixed(c) = param {
             bounded(p, name, c)?;
@@ -218,6 +218,8 @@ impl Builder<'_> {
                     (Textured::RoughPlastic { distribution, alpha, diffuse, specular, int_ior, ext_ior, nonlinear }, true)
                 }
             }
+            "principled" => (self.principled(p)?, true),
+            "principledthin" => (self.principled_thin(p)?, false),
             "twosided" => {
                 let inner = p.objects("bsdf")?;
                 p.finish("one or two nested <bsdf>")?;
@@ -233,7 +235,8 @@ impl Builder<'_> {
             k => {
                 return Err(p.refuse(format!(
                     "the '{k}' BSDF is not supported yet (diffuse, dielectric, thindielectric, roughdielectric, \
-                     conductor, roughconductor, plastic, roughplastic, blendbsdf, mask, null, normalmap, bumpmap and twosided are)"
+                     conductor, roughconductor, plastic, roughplastic, principled, principledthin, blendbsdf, mask, null, normalmap, \
+                     bumpmap and twosided are)"
                 )))
             }
         };

@@ -22,6 +22,7 @@ pub mod conductors;
 mod emitters;
 mod film;
 mod materials;
+mod principled;
 pub mod props;
 mod sensor;
 mod shapes;
