@@ -6,20 +6,24 @@
 //! and, as Mitsuba aligns the rows with the poles, at v = y / (H - 1);
 //! `scale` multiplies it.
 //!
-//! Directions are drawn from the map's pixels in proportion to their
-//! luminance times sin θ (the solid angle a pixel spans), mixed with a
-//! share of uniform directions so that the density is positive wherever
-//! bilinear interpolation carries light past a bright pixel's edge: the
-//! pdf is exact for the mixture, never approximate.
+//! Directions are drawn in proportion to the bilinear interpolation of
+//! luminance times sin θ between the texels (the solid angle a row spans
+//! shrinks as sin θ): the lattice of texel centres splits the map into
+//! cells, a cell is drawn by its integral and a point in it from the
+//! bilinear density (pbrt-v4's `SampleBilinear`, by its linear marginal
+//! and conditional). The map's radiance is the bilinear interpolation of
+//! the same texels, so the density is positive wherever light arrives
+//! (but exactly at a pole), and it is exact: the pdf of a direction is
+//! the bilinear density at it over 2π² sin θ. ∫ L dω, which a photon's
+//! power is a share of, is exact too: within a row the interpolation
+//! integrates to the row's mean, and between rows the linear blend times
+//! sin θ has a closed form.
 
 use crate::film::Film;
 use crate::math::Color;
 use crate::sampling::{uniform_cone, Discrete};
 use glam::{Mat3, Vec2, Vec3};
 use std::f32::consts::PI;
-
-/// The share of directions drawn uniformly over the sphere.
-const UNIFORM: f32 = 0.15;
 
 #[derive(Debug)]
 pub struct EnvMap {
@@ -29,9 +33,33 @@ pub struct EnvMap {
     /// The map's frame in world space (a rotation) and back.
     to_world: Mat3,
     to_local: Mat3,
-    pixels: Option<Discrete>,
+    /// Per texel, its luminance times sin θ of its row: the density's
+    /// values at the lattice's points.
+    weights: Vec<f32>,
+    /// The cells (between texel centres: `width` along u, `height - 1`
+    /// along v) by their integrals; `None` where the map is black (or one
+    /// row high), and directions are uniform.
+    cells: Option<Discrete>,
+    /// The cells' count over the sum of their mean weights: the density
+    /// over (u, v) is the bilinear weight times it.
+    norm: f32,
     /// ∫ L dω over the sphere, per channel.
     total: Color,
+}
+
+/// Luminance of linear sRGB (Rec. 709 weights).
+fn luminance(c: Color) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// A point in [0, 1) drawn with density proportional to (1 - x) a + x b
+/// (a, b >= 0, not both zero), from uniform `u` (pbrt-v4's SampleLinear).
+fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
+    if u == 0.0 && a == 0.0 {
+        return 0.0;
+    }
+    let x = u * (a + b) / (a + ((1.0 - u) * a * a + u * b * b).sqrt());
+    x.min(1.0 - f32::EPSILON / 2.0)
 }
 
 impl EnvMap {
@@ -39,31 +67,84 @@ impl EnvMap {
     pub fn new(image: &Film, scale: f32, to_world: Mat3) -> Self {
         let (width, height) = (image.width as usize, image.height as usize);
         let texels: Vec<Color> = image.pixels.iter().map(|c| (*c * scale).max(Color::ZERO)).collect();
-        let sin = |y: usize| (PI * (y as f32 + 0.5) / height as f32).sin();
-        let lum = |c: Color| 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
-        let pixels = Discrete::new((0..width * height).map(|i| (lum(texels[i]) * sin(i / width)) as f64));
-        let mut map =
-            EnvMap { width, height, texels, to_world, to_local: to_world.transpose(), pixels, total: Color::ZERO };
-        // ∫ L dω on a grid 4x finer than the image: each cell's value at
-        // its centre times its solid angle, exact in θ (cos θ0 - cos θ1).
-        let (nu, nv) = (4 * width, 4 * height);
-        let mut total = glam::DVec3::ZERO;
-        for j in 0..nv {
-            let v = (j as f32 + 0.5) / nv as f32;
-            let theta = |k: usize| std::f64::consts::PI * k as f64 / nv as f64;
-            let w = theta(j).cos() - theta(j + 1).cos();
-            for i in 0..nu {
-                let u = (i as f32 + 0.5) / nu as f32;
-                total += map.lookup(Vec2::new(u, v)).as_dvec3() * w;
-            }
-        }
-        map.total = (total * (2.0 * std::f64::consts::PI / nu as f64)).as_vec3();
+        let rows = height.max(2) - 1;
+        let sin = |y: usize| (std::f64::consts::PI * y as f64 / rows as f64).sin() as f32;
+        let weights: Vec<f32> = (0..width * height).map(|i| luminance(texels[i]) * sin(i / width)).collect();
+        let cell = |i: usize, j: usize| {
+            let w = |x: usize, y: usize| weights[y * width + x % width] as f64;
+            0.25 * (w(i, j) + w(i + 1, j) + w(i, j + 1) + w(i + 1, j + 1))
+        };
+        let cells =
+            if height >= 2 { Discrete::new((0..width * rows).map(|k| cell(k % width, k / width))) } else { None };
+        let sum: f64 = if height >= 2 { (0..width * rows).map(|k| cell(k % width, k / width)).sum() } else { 0.0 };
+        let norm = if sum > 0.0 { ((width * rows) as f64 / sum) as f32 } else { 0.0 };
+        let mut map = EnvMap {
+            width,
+            height,
+            texels,
+            to_world,
+            to_local: to_world.transpose(),
+            weights,
+            cells,
+            norm,
+            total: Color::ZERO,
+        };
+        map.total = map.integral();
         map
+    }
+
+    /// ∫ L dω, exactly for the bilinear interpolation: 2π² ∫∫ L sin(πv)
+    /// du dv, where each row integrates over u to its mean and two rows
+    /// blend linearly in v.
+    fn integral(&self) -> Color {
+        let (w, h) = (self.width, self.height);
+        let mean = |y: usize| {
+            self.texels[y * w..(y + 1) * w].iter().fold(glam::DVec3::ZERO, |a, c| a + c.as_dvec3()) / w as f64
+        };
+        if h < 2 {
+            // One row: the lookup is that row everywhere.
+            return (mean(0) * 4.0 * std::f64::consts::PI).as_vec3();
+        }
+        let step = 1.0 / (h - 1) as f64;
+        let alpha = std::f64::consts::PI * step;
+        let mut total = glam::DVec3::ZERO;
+        for j in 0..h - 1 {
+            let (t0, t1) = (alpha * j as f64, alpha * (j + 1) as f64);
+            // ∫0^1 b sin(α(j + b)) db and ∫0^1 (1 - b) sin(α(j + b)) db.
+            let i1 = -t1.cos() / alpha + (t1.sin() - t0.sin()) / (alpha * alpha);
+            let i0 = (t0.cos() - t1.cos()) / alpha - i1;
+            total += mean(j) * i0 + mean(j + 1) * i1;
+        }
+        (total * 2.0 * std::f64::consts::PI * std::f64::consts::PI * step).as_vec3()
     }
 
     /// ∫ L dω over the sphere, per channel.
     pub fn total(&self) -> Color {
         self.total
+    }
+
+    /// The map's texels (scaled) and its frame, as it was made.
+    pub fn image(&self) -> (Film, Mat3) {
+        (Film { width: self.width as u32, height: self.height as u32, pixels: self.texels.clone() }, self.to_world)
+    }
+
+    /// The radiance image an `envmap` names: OpenEXR, Radiance HDR, or
+    /// any image a bitmap texture reads (8-bit images decoded from sRGB,
+    /// as Mitsuba does).
+    pub fn load(path: &std::path::Path) -> Result<Film, String> {
+        let bitmap = crate::texture::Bitmap::load(path, false)?;
+        let res = bitmap.resolution();
+        let (w, h) = (res.x as u32, res.y as u32);
+        let mut pixels = Vec::with_capacity((w * h) as usize);
+        let mut nearest = bitmap;
+        nearest.filter = crate::texture::Filter::Nearest;
+        for y in 0..h {
+            for x in 0..w {
+                let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+                pixels.push(nearest.eval(uv));
+            }
+        }
+        Ok(Film { width: w, height: h, pixels })
     }
 
     fn uv(&self, world: Vec3) -> Vec2 {
@@ -102,36 +183,61 @@ impl EnvMap {
         self.lookup(self.uv(towards))
     }
 
+    /// The weight at lattice point (x, y), x periodic.
+    #[inline]
+    fn weight(&self, x: usize, y: usize) -> f32 {
+        self.weights[y * self.width + x % self.width]
+    }
+
+    /// The cell holding `uv` and the point's place in it: the cell's lower
+    /// corner (texel x, row y) and (a, b) in [0, 1]^2.
+    fn cell_of(&self, uv: Vec2) -> (usize, usize, f32, f32) {
+        let x = uv.x * self.width as f32 - 0.5;
+        let y = uv.y * (self.height - 1) as f32;
+        let (x0, y0) = (x.floor(), y.floor().clamp(0.0, (self.height - 2) as f32));
+        let i = (x0 as i64).rem_euclid(self.width as i64) as usize;
+        (i, y0 as usize, (x - x0).clamp(0.0, 1.0), (y - y0).clamp(0.0, 1.0))
+    }
+
     /// A unit world direction towards the map and its density (solid
     /// angle), for a point `u` uniform in the unit square.
     pub fn sample(&self, u: Vec2) -> (Vec3, f32) {
-        let dir = match &self.pixels {
-            Some(pixels) if u.x >= UNIFORM => {
-                let (i, rest) = pixels.sample((u.x - UNIFORM) / (1.0 - UNIFORM));
-                let (px, py) = (i % self.width, i / self.width);
-                let uv = Vec2::new((px as f32 + rest) / self.width as f32, (py as f32 + u.y) / self.height as f32);
-                self.direction(uv)
-            }
-            Some(_) => uniform_cone(Vec2::new(u.x / UNIFORM, u.y), -1.0).normalize(),
-            None => uniform_cone(u, -1.0).normalize(),
+        let Some(cells) = &self.cells else {
+            let dir = uniform_cone(u, -1.0).normalize();
+            return (dir, self.pdf(dir));
         };
-        (dir, self.pdf(dir))
+        let (k, rest) = cells.sample(u.x);
+        let (i, j) = (k % self.width, k / self.width);
+        let (w00, w10) = (self.weight(i, j), self.weight(i + 1, j));
+        let (w01, w11) = (self.weight(i, j + 1), self.weight(i + 1, j + 1));
+        let a = sample_linear(rest, w00 + w01, w10 + w11);
+        let b = sample_linear(u.y, w00 * (1.0 - a) + w10 * a, w01 * (1.0 - a) + w11 * a);
+        let uv =
+            Vec2::new(((i as f32 + 0.5 + a) / self.width as f32).fract(), (j as f32 + b) / (self.height - 1) as f32);
+        let dir = self.direction(uv);
+        // The density where the draw landed (the same as `pdf(dir)` but
+        // for rounding in the round trip through the direction).
+        let bilinear = (w00 * (1.0 - a) + w10 * a) * (1.0 - b) + (w01 * (1.0 - a) + w11 * a) * b;
+        let sin_theta = (uv.y * PI).sin();
+        let pdf = if sin_theta > 0.0 { bilinear * self.norm / (2.0 * PI * PI * sin_theta) } else { 0.0 };
+        (dir, pdf)
     }
 
     /// The density of [`Self::sample`] at unit world direction `dir`.
     pub fn pdf(&self, dir: Vec3) -> f32 {
-        let uniform = 1.0 / (4.0 * PI);
-        let Some(pixels) = &self.pixels else { return uniform };
+        if self.cells.is_none() {
+            return 1.0 / (4.0 * PI);
+        }
         let uv = self.uv(dir);
-        let px = ((uv.x * self.width as f32) as usize).min(self.width - 1);
-        let py = ((uv.y * self.height as f32) as usize).min(self.height - 1);
         let sin_theta = (uv.y * PI).sin();
-        let map = if sin_theta > 0.0 {
-            pixels.prob(py * self.width + px) * (self.width * self.height) as f32 / (2.0 * PI * PI * sin_theta)
-        } else {
-            0.0
-        };
-        UNIFORM * uniform + (1.0 - UNIFORM) * map
+        if !(sin_theta > 0.0) {
+            return 0.0;
+        }
+        let (i, j, a, b) = self.cell_of(uv);
+        let top = self.weight(i, j) * (1.0 - a) + self.weight(i + 1, j) * a;
+        let bottom = self.weight(i, j + 1) * (1.0 - a) + self.weight(i + 1, j + 1) * a;
+        let density_uv = (top * (1.0 - b) + bottom * b) * self.norm;
+        density_uv / (2.0 * PI * PI * sin_theta)
     }
 }
 
@@ -158,23 +264,60 @@ mod tests {
         assert!((m.direction(m.uv(d)) - d).length() < 1e-5);
     }
 
+    /// The exact integral against a fine midpoint sum of the lookups times
+    /// the solid angle, on an uneven map; where the map is black (its
+    /// lower half here) no direction is drawn, and wherever light arrives
+    /// the density is positive.
+    #[test]
+    fn the_integral_is_exact_and_the_density_covers_the_light() {
+        let m = map(12, 7, |x, y| if y >= 4 { Color::ZERO } else { Color::new(1.0 + x as f32, 0.5 * y as f32, 3.0) });
+        let (nu, nv) = (1200usize, 1400usize);
+        let mut sum = glam::DVec3::ZERO;
+        for j in 0..nv {
+            let v = (j as f64 + 0.5) / nv as f64;
+            let w = (std::f64::consts::PI * v).sin() * 2.0 * std::f64::consts::PI.powi(2) / (nu * nv) as f64;
+            for i in 0..nu {
+                let uv = Vec2::new(((i as f64 + 0.5) / nu as f64) as f32, v as f32);
+                sum += m.lookup(uv).as_dvec3() * w;
+            }
+        }
+        let exact = m.total().as_dvec3();
+        assert!((sum - exact).abs().max_element() < 1e-4 * exact.max_element(), "{sum} vs {exact}");
+        let mut state = 99u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((state >> 40) as f32) / (1u64 << 24) as f32
+        };
+        for _ in 0..20_000 {
+            let (d, pdf) = m.sample(Vec2::new(next(), next()));
+            assert!(pdf > 0.0 && m.eval(d).max_element() > 0.0, "{d}: pdf {pdf}, {}", m.eval(d));
+            let d = crate::sampling::uniform_cone(Vec2::new(next(), next()), -1.0).normalize();
+            assert_eq!(m.eval(d).max_element() > 0.0, m.pdf(d) > 0.0, "{d}");
+        }
+    }
+
     /// Irradiance from a constant map by its own sampling: E = π L on any
-    /// plane, whichever way it faces.
+    /// plane, whichever way it faces, within four standard errors.
     #[test]
     fn sampled_irradiance_is_pi_l() {
         let m = map(16, 8, |_, _| Color::splat(2.0));
+        let mut state = 5u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((state >> 40) as f32) / (1u64 << 24) as f32
+        };
         for n in [Vec3::Z, -Vec3::Z, Vec3::Y, Vec3::new(0.5, -0.5, 0.7).normalize()] {
-            let k = 400;
-            let mut e = 0.0f64;
-            for i in 0..k {
-                for j in 0..k {
-                    let u = Vec2::new((i as f32 + 0.5) / k as f32, (j as f32 + 0.5) / k as f32);
-                    let (d, pdf) = m.sample(u);
-                    e += (m.eval(d).x * d.dot(n).max(0.0) / pdf) as f64;
-                }
+            let k = 1_000_000;
+            let (mut sum, mut squares) = (0.0f64, 0.0f64);
+            for _ in 0..k {
+                let (d, pdf) = m.sample(Vec2::new(next(), next()));
+                let e = (m.eval(d).x * d.dot(n).max(0.0) / pdf) as f64;
+                sum += e;
+                squares += e * e;
             }
-            e /= (k * k) as f64;
-            assert!((e - 2.0 * std::f64::consts::PI).abs() < 2e-3 * e, "{n}: {e}");
+            let mean = sum / k as f64;
+            let se = ((squares / k as f64 - mean * mean) / k as f64).sqrt();
+            assert!((mean - 2.0 * std::f64::consts::PI).abs() < 4.0 * se, "{n}: {mean} +- {se}");
         }
     }
 

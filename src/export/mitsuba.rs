@@ -13,6 +13,7 @@
 //! | glass | `dielectric`; absorption as a `homogeneous` interior medium (then `volpath`) |
 //! | disk and triangle lights | `area` emitters (one-sided) on `disk` and `ply` shapes |
 //! | directional and point (1/d^2) lights | `directional`, `point` |
+//! | sky, environment map | `constant`, `envmap` (the map as a float EXR beside the meshes, already scaled; its rotation as `to_world`) |
 //! | Phong; point lights of other falloffs | refused |
 //!
 //! The XML takes `spp`, `seed`, `width` and `height` as parameters
@@ -42,8 +43,9 @@ use crate::shape::{Ellipsoid, Shape, FLAT};
 use glam::{Affine3A, Vec3};
 use std::fmt::Write;
 
-/// An exported scene: the XML text, the mesh files it names (relative
-/// paths and contents), and notes on what was written differently.
+/// An exported scene: the XML text, the files it names (meshes and
+/// environment maps: relative paths and contents), and notes on what was
+/// written differently.
 pub struct MitsubaScene {
     pub xml: String,
     pub meshes: Vec<(String, Vec<u8>)>,
@@ -249,6 +251,20 @@ pub fn to_mitsuba(
                     disk_transform(at(d.center), d.normal, d.radius * s),
                     bsdf_ref(*material),
                     rgb(*radiance)
+                );
+            }
+            // The map as a file beside the scene: the texels as they light
+            // it (scaled), in float32, so read back it is the same to the bit.
+            Light::Envmap(env) => {
+                emitters += &flush(&mut out, &mut tri_run);
+                let (image, to_world) = env.map.image();
+                let bytes = crate::output::exr_bytes(&image).map_err(|e| refuse(light_place(), e.to_string()))?;
+                let name = format!("{}/envmap{:03}.exr", out.mesh_dir, out.meshes.len());
+                out.meshes.push((name.clone(), bytes));
+                let _ = write!(
+                    emitters,
+                    "    <emitter type=\"envmap\">\n        <string name=\"filename\" value=\"{name}\"/>\n        {}\n    </emitter>\n",
+                    matrix(&Affine3A::from_mat3(to_world))
                 );
             }
             // Every other light describes itself, moved as the scene is.

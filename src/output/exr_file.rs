@@ -73,6 +73,23 @@ pub(super) fn write_channels(
     Image::from_layer(layer).write().to_file(tmp).map_err(|e| encode_error(tmp, e))
 }
 
+/// An RGB image as the bytes of an EXR file, without photonmap's
+/// attributes: a file another program reads (an environment map the
+/// Mitsuba export writes beside its scene).
+pub fn exr_bytes(film: &Film) -> Result<Vec<u8>> {
+    let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+    for (name, samples) in rgb_channels("", film) {
+        let Samples::F32(v) = samples else { unreachable!("colour channels are floats") };
+        list.push(AnyChannel::new(text(&name), FlatSamples::F32(v)));
+    }
+    let encoding = Encoding { line_order: LineOrder::Increasing, ..Encoding::FAST_LOSSLESS };
+    let size = (film.width as usize, film.height as usize);
+    let layer = Layer::new(size, LayerAttributes::default(), encoding, AnyChannels::sort(list));
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    Image::from_layer(layer).write().to_buffered(&mut bytes).map_err(|e| encode_error(Path::new("(memory)"), e))?;
+    Ok(bytes.into_inner())
+}
+
 /// Text as the header stores it: UTF-8 bytes (exr's own constructor takes
 /// only Latin-1 and panics otherwise; a path may hold any character).
 fn text(s: &str) -> Text {

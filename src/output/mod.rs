@@ -12,7 +12,7 @@ use std::sync::Mutex;
 mod exr_file;
 pub mod partial;
 
-pub use exr_file::{read_exr, read_header, Header};
+pub use exr_file::{exr_bytes, read_exr, read_header, Header};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
@@ -178,6 +178,20 @@ fn atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()
         Error::Encode { message, .. } => Error::Encode { path: path.to_owned(), message },
         other => other,
     })
+}
+
+/// An image as the bytes of a Radiance HDR (RGBE) file: 8 bits of
+/// mantissa per channel under a shared exponent, so each value within
+/// 0.4% of the film's (a compact file for a committed environment map).
+pub fn hdr_bytes(film: &Film) -> Result<Vec<u8>> {
+    let fail = |message: String| Error::Encode { path: PathBuf::from("(memory)"), message };
+    let pixels: Vec<image::Rgb<f32>> =
+        film.pixels.iter().map(|c| image::Rgb(c.max(crate::math::Color::ZERO).to_array())).collect();
+    let mut bytes = Vec::new();
+    image::codecs::hdr::HdrEncoder::new(&mut bytes)
+        .encode(&pixels, film.width as usize, film.height as usize)
+        .map_err(|e| fail(e.to_string()))?;
+    Ok(bytes)
 }
 
 /// PNG by the image crate; PPM as binary P6 (what the course's readers and

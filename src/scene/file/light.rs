@@ -1,9 +1,11 @@
-//! `[[lights]]`: disk, point and directional lights.
+//! `[[lights]]`: disk, point and directional lights, and light from
+//! everywhere: a constant sky and an environment map.
 
 use super::build::{at, Builder};
 use super::defs::{Entry, V3};
+use super::shape::StepDef;
 use super::SceneError;
-use crate::light::{AreaLight, Directional, Emitting, Light};
+use crate::light::{AreaLight, Constant, Directional, Emitting, Environment, Light};
 use crate::shape::Disk;
 use serde::Deserialize;
 use toml::Spanned;
@@ -34,6 +36,25 @@ struct PointLight {
 struct DirectionalLight {
     direction: Spanned<V3>,
     color: Spanned<V3>,
+}
+
+/// `type = "sky"`: radiance arriving equally from every direction
+/// (Mitsuba's `constant`).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SkyLight {
+    radiance: Spanned<V3>,
+}
+
+/// `type = "envmap"`: a latitude-longitude image at infinity (Mitsuba's
+/// `envmap`): its top row towards the map's +y, turned by `transform`'s
+/// rotations, its values times `scale`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EnvmapLight {
+    file: Spanned<String>,
+    scale: Option<Spanned<f32>>,
+    transform: Option<Vec<Spanned<StepDef>>>,
 }
 
 impl Builder<'_> {
@@ -79,12 +100,41 @@ impl Builder<'_> {
                 let irradiance = self.color(&at(&d.color, f("color")))?;
                 Light::Directional(Directional::new(direction, irradiance))
             }
+            "sky" => {
+                let d: SkyLight = entry.read(&self.src)?;
+                Light::Constant(Constant::new(self.color(&at(&d.radiance, f("radiance")))?))
+            }
+            "envmap" => {
+                let d: EnvmapLight = entry.read(&self.src)?;
+                let scale = match &d.scale {
+                    Some(v) => self.number(&at(v, f("scale")), 0.0, 1e30, false)?,
+                    None => 1.0,
+                };
+                // A map is turned, never moved or stretched: it is at infinity.
+                for (j, step) in d.transform.iter().flatten().enumerate() {
+                    if step.get_ref().rotate.is_none() {
+                        return self.fail(
+                            step.span(),
+                            &f(&format!("transform[{j}]")),
+                            "an environment map is only turned: each step is a rotate",
+                        );
+                    }
+                }
+                let m = self.transform(&f("transform"), &d.transform)?;
+                let file = at(&d.file, f("file"));
+                let path = self.src.path.parent().unwrap_or(std::path::Path::new(".")).join(file.value);
+                let image = crate::envmap::EnvMap::load(&path).map_err(|e| {
+                    self.src.error(file.span.clone(), file.field.clone(), format!("{}: {e}", path.display()))
+                })?;
+                let map = crate::envmap::EnvMap::new(&image, scale, glam::Mat3::from(m.matrix3));
+                Light::Envmap(Environment::new(std::sync::Arc::new(map)))
+            }
             other => {
                 let kind = entry.kind();
                 return self.fail(
                     kind.span.clone(),
                     &kind.field,
-                    format!("unknown light type \"{other}\" (disk, point, directional)"),
+                    format!("unknown light type \"{other}\" (disk, point, directional, sky, envmap)"),
                 );
             }
         };

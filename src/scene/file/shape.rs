@@ -95,10 +95,15 @@ pub struct RotateDef {
 }
 
 impl Builder<'_> {
-    pub(super) fn transform(&self, i: usize, steps: &Option<Vec<Spanned<StepDef>>>) -> Result<Affine3A, SceneError> {
+    /// The steps of the `transform` at `prefix` (e.g. `shapes[2].transform`).
+    pub(super) fn transform(
+        &self,
+        prefix: &str,
+        steps: &Option<Vec<Spanned<StepDef>>>,
+    ) -> Result<Affine3A, SceneError> {
         let mut m = Affine3A::IDENTITY;
         for (j, step) in steps.iter().flatten().enumerate() {
-            let field = format!("shapes[{i}].transform[{j}]");
+            let field = format!("{prefix}[{j}]");
             let s = step.get_ref();
             let set = [s.translate.is_some(), s.rotate.is_some(), s.scale.is_some()];
             if set.iter().filter(|&&b| b).count() != 1 {
@@ -156,7 +161,7 @@ impl Builder<'_> {
                 let d: Mesh = entry.read(&self.src)?;
                 let emission = self.emission(i, &d.emission)?;
                 let file = at(&d.file, f("file"));
-                let m = self.transform(i, &d.transform)?;
+                let m = self.transform(&f("transform"), &d.transform)?;
                 let obj_path = self.src.path.parent().unwrap_or(Path::new(".")).join(file.value);
                 let mesh = load_obj(&obj_path).map_err(|e| self.src.error(file.span.clone(), file.field.clone(), e))?;
                 self.meshes.push(obj_path.clone());
@@ -193,7 +198,7 @@ impl Builder<'_> {
             "ellipsoid" => {
                 let d: EllipsoidDef = self.read_shape(&mut entry)?;
                 let material = self.material_ref(&d.material, f("material"))?;
-                let m = self.transform(i, &d.transform)?;
+                let m = self.transform(&f("transform"), &d.transform)?;
                 let e = Ellipsoid::new(m)
                     .ok_or_else(|| self.src.error(kind_span.clone(), f("transform"), "the transform is singular"))?;
                 self.prims.push(Prim { shape: Shape::Ellipsoid(e), material, object });

@@ -28,7 +28,8 @@ impl Builder<'_> {
 }
 
 impl Builder<'_> {
-    /// An environment map from a latitude-longitude EXR.
+    /// An environment map from a latitude-longitude image (OpenEXR,
+    /// Radiance HDR, or any image a bitmap reads).
     fn envmap(&mut self, p: &Plugin) -> Result<Light, SceneError> {
         let (name, loc) = p.string("filename")?.ok_or_else(|| p.refuse("an envmap needs a filename"))?;
         let scale = p.float_in("scale", 1.0, 0.0, 1e30)?;
@@ -37,12 +38,9 @@ impl Builder<'_> {
             return Err(p.fail(p.loc(), "mis_compensation", "is not supported"));
         }
         p.finish("filename, scale, to_world, mis_compensation (false)")?;
-        if !name.to_lowercase().ends_with(".exr") {
-            return Err(p.fail(&loc, "filename", format!("'{name}': only OpenEXR environment maps are read yet")));
-        }
         let path = self.resolve(&name, &loc)?;
-        let image =
-            crate::output::read_exr(&path).map_err(|e| p.fail(&loc, "filename", format!("{}: {e}", path.display())))?;
+        let image = crate::envmap::EnvMap::load(&path)
+            .map_err(|e| p.fail(&loc, "filename", format!("{}: {e}", path.display())))?;
         if image.pixels.iter().any(|c| !c.is_finite()) {
             return Err(p.fail(&loc, "filename", "the map holds non-finite values"));
         }
