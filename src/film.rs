@@ -29,6 +29,30 @@ pub enum ToneMap {
     Clamp,
 }
 
+impl ToneMap {
+    pub const ALL: [ToneMap; 4] = [ToneMap::Display, ToneMap::Linear, ToneMap::Sqrt, ToneMap::Clamp];
+
+    /// Its name on command lines.
+    pub fn name(self) -> &'static str {
+        match self {
+            ToneMap::Display => "display",
+            ToneMap::Linear => "linear",
+            ToneMap::Sqrt => "sqrt",
+            ToneMap::Clamp => "clamp",
+        }
+    }
+
+    /// What it does, for a command's help.
+    pub fn description(self) -> &'static str {
+        match self {
+            ToneMap::Display => "Exposure from the image (its log-average luminance to middle grey), then sRGB.",
+            ToneMap::Linear => "The course's: v * 255.99 / i_max, i_max the largest channel value.",
+            ToneMap::Sqrt => "The course's square-root variant: sqrt(v) * 255.99 / sqrt(i_max).",
+            ToneMap::Clamp => "v * 255.99 clamped: 1.0 is white (the Whitted course's colours).",
+        }
+    }
+}
+
 impl Film {
     pub fn new(width: u32, height: u32) -> Self {
         Film { width, height, pixels: vec![Color::ZERO; width as usize * height as usize] }

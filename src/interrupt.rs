@@ -32,3 +32,22 @@ pub fn keep_work() {
 pub fn work_to_keep() -> bool {
     KEEPING.load(Ordering::Relaxed)
 }
+
+/// What a signal does in `photonmap` (its handler calls this): before
+/// rendering starts there is nothing to keep, and the first exits at once;
+/// during a render the first asks it to stop (a progressive render writes
+/// the passes it has and exits 130), a second exits at once. An exit
+/// removes any file half-written.
+pub fn on_signal() {
+    if !work_to_keep() {
+        crate::output::remove_temporaries();
+        eprintln!("\nphotonmap: interrupted (no half-written file is left)");
+        std::process::exit(130);
+    }
+    if requested() {
+        crate::output::remove_temporaries();
+        std::process::exit(130);
+    }
+    eprintln!("\nphotonmap: stopping (the passes finished are kept; Ctrl-C again to quit at once)");
+    request();
+}

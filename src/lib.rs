@@ -21,6 +21,7 @@
 
 pub mod accel;
 pub mod camera;
+pub mod command;
 pub mod display;
 pub mod envmap;
 pub mod error;

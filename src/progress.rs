@@ -1,7 +1,6 @@
 //! Progress for long phases: a bar on a terminal, a few plain lines
 //! otherwise (logs, CI), nothing with `--quiet`.
 
-use crate::render::{Budget, PassReport};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -68,100 +67,29 @@ impl Phase {
     }
 }
 
-/// Seconds more a progressive render needs to reach its `--target-error`
-/// (None: no target, or no prediction yet). Noise falls as the square root
-/// of the passes: the passes the worst region needs, from its error now, at
-/// the time per pass so far.
-pub fn seconds_to_target(budget: &Budget, r: &PassReport) -> Option<f64> {
-    let target = budget.target_error?;
-    let per_pass = r.elapsed.as_secs_f64() / r.rendered.max(1) as f64;
-    let worst = r.predictions.iter().skip((!budget.windows.is_empty()) as usize);
-    let e = worst.map(|(_, p)| p.relative_rmse()).reduce(f64::max)?;
-    let need = r.passes as f64 * (e / target).powi(2);
-    Some(per_pass * (need - r.passes as f64).max(0.0))
-}
+/// A bar of a progressive render's passes: a message and a position of a
+/// known length, or a spinner.
+pub struct Bar(ProgressBar);
 
-/// Progress of a progressive render: passes done, radii, predicted
-/// error, time left.
-pub struct PassDisplay {
-    mode: Mode,
-    budget: Budget,
-    first: u32,
-    bar: Option<ProgressBar>,
-    last_line: std::cell::Cell<Option<std::time::Instant>>,
-}
-
-impl PassDisplay {
-    /// `first`: the first pass this run renders (a resumed render's passes
-    /// before it are done already).
-    pub fn new(mode: Mode, budget: Budget, first: u32) -> Self {
-        let bar = (mode == Mode::Bar).then(|| {
-            let bar = match (budget.end, budget.seconds) {
-                (Some(n), _) => ProgressBar::new(n.saturating_sub(first) as u64),
-                (None, Some(s)) => ProgressBar::new(s.ceil() as u64),
-                (None, None) => ProgressBar::new_spinner(),
-            };
-            if let Ok(style) = ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}") {
-                bar.set_style(style.progress_chars("=> "));
-            }
-            bar
-        });
-        PassDisplay { mode, budget, first, bar, last_line: std::cell::Cell::new(None) }
+impl Bar {
+    pub fn new(len: Option<u64>) -> Bar {
+        let bar = match len {
+            Some(n) => ProgressBar::new(n),
+            None => ProgressBar::new_spinner(),
+        };
+        if let Ok(style) = ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}") {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        Bar(bar)
     }
 
-    /// Seconds left by the budget's nearest limit (None: unknown yet).
-    fn left(&self, r: &PassReport) -> Option<f64> {
-        let elapsed = r.elapsed.as_secs_f64();
-        let per_pass = elapsed / r.rendered.max(1) as f64;
-        let mut left: Option<f64> = None;
-        let mut take = |v: f64| left = Some(left.map_or(v, |l: f64| l.min(v)));
-        if let Some(end) = self.budget.end {
-            take(per_pass * end.saturating_sub(self.first + r.rendered) as f64);
-        }
-        if let Some(s) = self.budget.seconds {
-            take((s - elapsed).max(0.0));
-        }
-        if let Some(more) = seconds_to_target(&self.budget, r) {
-            take(more);
-        }
-        left
-    }
-
-    pub fn update(&self, r: &PassReport) {
-        let elapsed = r.elapsed.as_secs_f64();
-        let mut msg = format!("pass {:>5}  radius cap {:.4} caustic, {:.4} global", r.passes, r.r_caustic, r.r_global);
-        for (name, p) in &r.predictions {
-            msg += &format!("  {name} ±{:.1}%", 100.0 * p.relative_rmse());
-        }
-        msg += &format!("  {elapsed:.1} s");
-        if let Some(left) = self.left(r) {
-            msg += &format!(", ~{left:.0} s left");
-        }
-        match (&self.bar, self.mode) {
-            (Some(bar), _) => {
-                bar.set_message(msg);
-                bar.set_position(match (self.budget.end, self.budget.seconds) {
-                    (Some(_), _) => r.rendered as u64,
-                    (None, Some(_)) => elapsed as u64,
-                    (None, None) => r.passes as u64,
-                });
-            }
-            (None, Mode::Plain) => {
-                // A line every few seconds: logs stay readable at any pass rate.
-                let now = std::time::Instant::now();
-                if self.last_line.get().is_none_or(|t| now.duration_since(t).as_secs_f64() >= 2.0) {
-                    eprintln!("{msg}");
-                    self.last_line.set(Some(now));
-                }
-            }
-            _ => {}
-        }
+    pub fn show(&self, message: String, position: u64) {
+        self.0.set_message(message);
+        self.0.set_position(position);
     }
 
     pub fn finish(self) {
-        if let Some(bar) = self.bar {
-            bar.finish_and_clear();
-        }
+        self.0.finish_and_clear();
     }
 }
 

@@ -1,22 +1,22 @@
 //! Rendering: a render method ([`method`]: photon mapping, path tracing,
 //! the Whitted tracer) renders passes (a photon stage where it has one,
 //! then the camera pass); a classic render is one pass, a progressive
-//! render averages passes whose estimates narrow ([`progressive`]).
+//! render averages passes whose estimates narrow; the driver ([`driver`])
+//! runs either within a budget, reporting each pass to observers.
 
 pub mod accumulation;
 pub mod camera_pass;
+pub mod driver;
 pub mod error_estimate;
 pub mod method;
 pub mod photon_stage;
-pub mod progressive;
 mod rims;
-pub mod summary;
 pub mod tracers;
 
 pub use camera_pass::{camera_pass, CameraPass, Placement};
+pub use driver::{drive, render_passes, render_progressive, Budget, Observer, PassReport, Plan, Run, Stopped};
 pub use method::{Method, RenderMethod};
 pub use photon_stage::GLOBAL_GRID_CELL;
-pub use progressive::{render_passes, render_progressive, Budget, PassReport, Run, Stopped};
 
 use crate::film::Film;
 use crate::progress::Mode;

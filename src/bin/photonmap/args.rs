@@ -1,5 +1,5 @@
 //! Option values shared by the commands: parsers that say what is wrong
-//! with a value, the tone map, windows.
+//! with a value, the library's tables by name, windows.
 
 use clap::builder::PossibleValue;
 use clap::ValueEnum;
@@ -8,46 +8,52 @@ use photonmap::metrics::Window;
 use photonmap::render::Method;
 use std::sync::LazyLock;
 
-/// A render method (`--integrator`): those of the library's table that
-/// estimate radiance, by their names.
+/// A value of one of the library's tables, by its name: the render
+/// methods that estimate radiance (`--integrator`), the tone maps
+/// (`--tonemap`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct MethodArg(pub Method);
+pub struct Named<T>(pub T);
 
-static METHODS: LazyLock<Vec<MethodArg>> =
-    LazyLock::new(|| Method::ALL.into_iter().filter(|m| m.estimates_radiance()).map(MethodArg).collect());
+pub trait Table: Copy + Send + Sync + Sized + 'static {
+    fn entries() -> &'static [Named<Self>];
+    fn name(self) -> &'static str;
+    fn help(self) -> &'static str;
+}
 
-impl ValueEnum for MethodArg {
+impl<T: Table> ValueEnum for Named<T> {
     fn value_variants<'a>() -> &'a [Self] {
-        &METHODS
+        T::entries()
     }
 
     fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(PossibleValue::new(self.0.name()).help(self.0.description()))
+        Some(PossibleValue::new(self.0.name()).help(self.0.help()))
     }
 }
 
-/// How 8-bit outputs are made from radiance (`--tonemap`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ToneMapArg {
-    /// Exposure from the image (its log-average luminance to middle grey),
-    /// then the sRGB curve.
-    Display,
-    /// The course's: v * 255.99 / i_max, i_max the largest channel value.
-    Linear,
-    /// The course's square-root variant: sqrt(v) * 255.99 / sqrt(i_max).
-    Sqrt,
-    /// v * 255.99 clamped: 1.0 is white (the Whitted course's colours).
-    Clamp,
+impl Table for Method {
+    fn entries() -> &'static [Named<Method>] {
+        static E: LazyLock<Vec<Named<Method>>> =
+            LazyLock::new(|| Method::ALL.into_iter().filter(|m| m.estimates_radiance()).map(Named).collect());
+        &E
+    }
+    fn name(self) -> &'static str {
+        Method::name(self)
+    }
+    fn help(self) -> &'static str {
+        self.description()
+    }
 }
 
-impl ToneMapArg {
-    pub fn tonemap(self) -> ToneMap {
-        match self {
-            ToneMapArg::Display => ToneMap::Display,
-            ToneMapArg::Linear => ToneMap::Linear,
-            ToneMapArg::Sqrt => ToneMap::Sqrt,
-            ToneMapArg::Clamp => ToneMap::Clamp,
-        }
+impl Table for ToneMap {
+    fn entries() -> &'static [Named<ToneMap>] {
+        static E: LazyLock<Vec<Named<ToneMap>>> = LazyLock::new(|| ToneMap::ALL.into_iter().map(Named).collect());
+        &E
+    }
+    fn name(self) -> &'static str {
+        ToneMap::name(self)
+    }
+    fn help(self) -> &'static str {
+        self.description()
     }
 }
 
@@ -67,10 +73,6 @@ pub fn parse_count(s: &str) -> Result<u64, String> {
         return Err(format!("'{s}' is more than the 1e9 photons a map can hold"));
     }
     Ok(v as u64)
-}
-
-pub fn parse_seed(s: &str) -> Result<u64, String> {
-    s.trim().parse::<u64>().map_err(|_| format!("'{s}' must be a whole number from 0 to {}", u64::MAX))
 }
 
 pub fn parse_radius(s: &str) -> Result<f32, String> {

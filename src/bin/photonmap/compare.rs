@@ -1,13 +1,10 @@
-//! `photonmap compare TEST.exr REF.exr`: a render's error against a
-//! reference, with the metric of `photonmap::metrics`; with
-//! `--mitsuba-test` and the reference's variance, Mitsuba 3's acceptance
-//! test instead (`mitsuba.rs`).
+//! `photonmap compare TEST.exr REF.exr`: the flags of
+//! `photonmap::command::compare`.
 
-mod mitsuba;
-
+use crate::args::parse_windows;
+use photonmap::command::compare::{self, Request};
 use photonmap::error::Error;
-use photonmap::metrics::{compare_images, diff_rgb8, Comparison, Region, Window};
-use photonmap::output::{check_writable, read_exr, same_file, write_rgb8_image};
+use std::io::Write;
 use std::path::PathBuf;
 
 /// Scores TEST against REF: RMSE, relMSE, means and the test's relative
@@ -64,108 +61,20 @@ fn parse_scale(s: &str) -> Result<f32, String> {
 }
 
 pub fn run(args: Args) -> Result<(), Error> {
-    if args.mitsuba_test {
-        mitsuba::run(&args);
-    }
-    let windows: Vec<Window> = args
-        .windows
-        .iter()
-        .enumerate()
-        .map(|(i, w)| Window::parse(w, i))
-        .collect::<Result<_, _>>()
-        .map_err(|e| Error::Invalid(format!("--window: {e}")))?;
-    if let Some(diff) = &args.diff {
-        check_writable(diff)?;
-        for input in [&args.test, &args.reference] {
-            if same_file(diff, input) {
-                return Err(Error::Invalid(format!("--diff {}: that is an input of the comparison", diff.display())));
-            }
-        }
-    }
-    let test = read_exr(&args.test)?;
-    let reference = read_exr(&args.reference)?;
-    let c = compare_images(&test, &reference, &windows)
-        .map_err(|e| Error::Invalid(format!("{} against {}: {e}", args.test.display(), args.reference.display())))?;
-    let diff_scale = match &args.diff {
-        Some(path) => {
-            let reduced = photonmap::metrics::box_down(&test, c.factor);
-            let (rgb, scale) = diff_rgb8(&reduced, &reference, args.diff_scale);
-            write_rgb8_image(path, reference.width, reference.height, rgb)?;
-            Some(scale)
-        }
-        None => None,
+    let request = Request {
+        windows: parse_windows(&args.windows).map_err(Error::Invalid)?,
+        test: args.test,
+        reference: args.reference,
+        variance: args.variance,
+        fail_map: args.fail_map,
+        diff: args.diff,
+        diff_scale: args.diff_scale,
+        json: args.json,
     };
-    if args.json {
-        println!("{}", json(&c, diff_scale));
-    } else {
-        print!("{}", table(&c, &args, diff_scale));
+    if !args.mitsuba_test {
+        return compare::run(&request);
     }
-    Ok(())
-}
-
-fn region_json(r: &Region) -> serde_json::Value {
-    serde_json::json!({
-        "rmse": r.rmse,
-        "relmse": r.relmse,
-        "mean_test": r.mean_test,
-        "mean_ref": r.mean_ref,
-        "bias": r.relative_bias(),
-        "pixels": r.pixels,
-    })
-}
-
-pub fn json(c: &Comparison, diff_scale: Option<f32>) -> serde_json::Value {
-    let windows: Vec<serde_json::Value> = c
-        .windows
-        .iter()
-        .map(|(w, r)| {
-            let mut v = region_json(r);
-            v["name"] = w.name.clone().into();
-            v["rows"] = serde_json::json!([w.rows.0, w.rows.1]);
-            v["cols"] = serde_json::json!([w.cols.0, w.cols.1]);
-            v
-        })
-        .collect();
-    let mut v = serde_json::json!({
-        "factor": c.factor,
-        "whole": region_json(&c.whole),
-        "windows": windows,
-        "nan_count": c.nan_count,
-        "speckles": c.speckles,
-    });
-    if let Some(s) = diff_scale {
-        v["diff_scale"] = s.into();
-    }
-    v
-}
-
-fn table(c: &Comparison, args: &Args, diff_scale: Option<f32>) -> String {
-    let mut out = String::new();
-    let reduced = if c.factor > 1 { format!(" (test reduced {0}x{0})", c.factor) } else { String::new() };
-    out += &format!("{} against {}{reduced}\n", args.test.display(), args.reference.display());
-    out +=
-        &format!("{:<12} {:>10} {:>10} {:>10} {:>10} {:>8}\n", "region", "rmse", "relmse", "mean", "ref mean", "bias");
-    let row = |name: &str, r: &Region| {
-        let bias = match r.relative_bias() {
-            Some(b) => format!("{:>+7.2}%", 100.0 * b),
-            None => "undefined".into(),
-        };
-        format!(
-            "{:<12} {:>10.6} {:>10.6} {:>10.6} {:>10.6} {bias:>8}\n",
-            name, r.rmse, r.relmse, r.mean_test, r.mean_ref
-        )
-    };
-    out += &row("whole", &c.whole);
-    for (w, r) in &c.windows {
-        out += &row(&w.name, r);
-    }
-    if std::iter::once(&c.whole).chain(c.windows.iter().map(|(_, r)| r)).any(|r| r.relative_bias().is_none()) {
-        out += "bias undefined: the reference's mean is 0 there, so no relative figure means anything\n";
-    }
-    let scored = if c.nan_count > 0 { " (scored as 0)" } else { "" };
-    out += &format!("speckles: {} pixels; non-finite values in the test: {}{scored}\n", c.speckles, c.nan_count);
-    if let (Some(path), Some(s)) = (&args.diff, diff_scale) {
-        out += &format!("difference picture: {} (full intensity at {s:.4})\n", path.display());
-    }
-    out
+    let code = compare::mitsuba_status(&request);
+    let _ = std::io::stdout().flush();
+    std::process::exit(code.into())
 }

@@ -1,7 +1,7 @@
 //! A count option's value (`--spp 1e3`, `--passes 256`, `--width 800`):
 //! every count takes the notation --photons takes, a whole number written
-//! plainly or in e-notation, within the option's range. Shared by both
-//! programs.
+//! plainly or in e-notation, within the option's range; and a seed. Shared
+//! by both programs.
 
 use clap::builder::TypedValueParser;
 use clap::error::ErrorKind;
@@ -32,6 +32,11 @@ impl Count {
         }
         Ok(v as u32)
     }
+}
+
+/// A seed: any 64-bit whole number.
+pub fn parse_seed(s: &str) -> Result<u64, String> {
+    s.trim().parse::<u64>().map_err(|_| format!("'{s}' must be a whole number from 0 to {}", u64::MAX))
 }
 
 impl TypedValueParser for Count {

@@ -5,16 +5,11 @@
 //! panicked.
 
 mod args;
-mod checks;
 mod compare;
 mod count;
 mod export;
-mod info;
 mod merge;
-mod outputs;
 mod render;
-mod summary;
-mod write;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -45,28 +40,16 @@ enum Command {
     /// Add partial renders (--partial) into one image.
     Merge(merge::Args),
     /// Print how an EXR was made (its header) and a partial's parts.
-    Info(info::Args),
+    Info {
+        #[arg(required = true, value_name = "FILE.exr")]
+        files: Vec<std::path::PathBuf>,
+    },
 }
 
 /// Ctrl-C (SIGINT), SIGTERM or SIGHUP (the ctrlc crate's `termination`
-/// feature): the first asks the render to stop (a progressive render writes
-/// the passes it has and exits 130); a second exits at once, removing any
-/// file half-written. Before rendering starts (loading the scene, the
-/// subcommands) there is nothing to keep, and the first exits at once.
+/// feature): `photonmap::interrupt::on_signal` decides.
 fn handle_signals() {
-    let _ = ctrlc::set_handler(|| {
-        if !photonmap::interrupt::work_to_keep() {
-            photonmap::output::remove_temporaries();
-            eprintln!("\nphotonmap: interrupted (no half-written file is left)");
-            std::process::exit(130);
-        }
-        if photonmap::interrupt::requested() {
-            photonmap::output::remove_temporaries();
-            std::process::exit(130);
-        }
-        eprintln!("\nphotonmap: stopping (the passes finished are kept; Ctrl-C again to quit at once)");
-        photonmap::interrupt::request();
-    });
+    let _ = ctrlc::set_handler(photonmap::interrupt::on_signal);
 }
 
 /// The command line, negative numbers taken as values in every subcommand
@@ -89,10 +72,11 @@ fn main() -> ExitCode {
         Some(Command::Compare(args)) => compare::run(args),
         Some(Command::Export(args)) => export::run(args),
         Some(Command::Merge(args)) => merge::run(args),
-        Some(Command::Info(args)) => info::run(args),
-        None => render::run(cli.render).map(|outcome| match outcome {
-            render::Outcome::Done => (),
-            render::Outcome::Interrupted => std::process::exit(130),
+        Some(Command::Info { files }) => photonmap::command::info::run(&files),
+        None => render::run(cli.render).map(|outcome| {
+            if outcome == photonmap::command::render::Outcome::Interrupted {
+                std::process::exit(130)
+            }
         }),
     };
     match result {

@@ -1,9 +1,15 @@
 //! The files a run writes: checked before any rendering (each can be
 //! created, none is an input, none is named twice), then written
-//! atomically, every one of them whatever happens to the others.
+//! atomically, every one of them whatever happens to the others: images
+//! (EXRs with their provenance and, where there is one, the error
+//! estimate's layers), the error heat map, the partial render.
 
-use photonmap::error::Error;
-use photonmap::output::{check_writable, same_file, Format};
+use crate::error::Error;
+use crate::film::{Film, ToneMap};
+use crate::metrics::heat_rgb8;
+use crate::output::partial::{write_partial, Partial};
+use crate::output::{check_writable, same_file, write_rgb8_image, write_with, Extras, Format};
+use crate::render::error_estimate::ErrorEstimate;
 use std::path::{Path, PathBuf};
 
 /// Every output of a run, by role.
@@ -72,5 +78,66 @@ impl Outputs {
             }
         }
         Ok(())
+    }
+}
+
+/// An image and what it is.
+pub struct Written<'a> {
+    pub film: &'a Film,
+    pub error: Option<&'a ErrorEstimate>,
+    /// How it was made (an EXR's header attributes).
+    pub attributes: Vec<(String, String)>,
+}
+
+/// How 8-bit outputs are made from radiance.
+#[derive(Clone, Copy, Debug)]
+pub struct Look {
+    pub tonemap: ToneMap,
+    pub exposure: f32,
+}
+
+/// Writes every output, each whatever becomes of the others; the first
+/// failure is returned after all were tried. Returns the files written.
+pub fn write_outputs(
+    outputs: &Outputs,
+    w: &Written,
+    partial: Option<&Partial>,
+    look: Look,
+) -> Result<Vec<PathBuf>, Error> {
+    let mut extras = Extras { attributes: w.attributes.clone(), layers: Vec::new() };
+    if let Some(e) = w.error {
+        extras.attributes.push(("error_passes".into(), e.passes.to_string()));
+        extras.layers =
+            vec![("error".into(), e.error_film()), ("noise".into(), e.noise_film()), ("bias".into(), e.bias_film())];
+    }
+    let mut written = Vec::new();
+    let mut first_error = None;
+    let mut record = |path: &PathBuf, result: Result<(), Error>| match result {
+        Ok(()) => written.push(path.clone()),
+        Err(e) => {
+            first_error.get_or_insert(e);
+        }
+    };
+    for path in &outputs.images {
+        record(path, write_with(path, w.film, look.tonemap, look.exposure, &extras));
+    }
+    if let Some(path) = &outputs.error_map {
+        match w.error {
+            Some(e) => {
+                let (rgb, _) = heat_rgb8(&e.error_film(), None);
+                record(path, write_rgb8_image(path, w.film.width, w.film.height, rgb));
+            }
+            None => eprintln!(
+                "photonmap: warning: --error-map {}: too few passes for an error estimate yet",
+                path.display()
+            ),
+        }
+    }
+    if let (Some(path), Some(p)) = (&outputs.partial, partial) {
+        record(path, write_partial(path, p));
+    }
+    match first_error {
+        Some(e) => Err(e),
+        None => Ok(written),
     }
 }

@@ -1,15 +1,21 @@
-//! Progressive rendering: independent passes, averaged. Each photon-mapping
-//! pass has its own photons and narrower estimates than the pass before
-//! ([`super::photon_stage::Estimates::progressive`]), so the average
-//! converges to the true image.
+//! The render driver: runs a render method's passes as a [`Plan`] says
+//! (one pass as rendered, or passes averaged: a new render, a range of
+//! passes for a partial, more passes on a partial's sums) within a
+//! [`Budget`] (passes, time, a target error), and reports each pass to
+//! [`Observer`]s (progress, previews, periodic writes, a caller's stop).
 //!
-//! A pass depends only on its index (random streams are keyed by pass, the
-//! radius schedule is global), and the passes' sums are exact
-//! ([`super::accumulation`]): any set of passes can be rendered anywhere,
-//! in any order, and added into the same image as one process would make.
+//! Progressive rendering: independent passes, averaged. Each
+//! photon-mapping pass has its own photons and narrower estimates than the
+//! pass before ([`super::photon_stage::Estimates::progressive`]), so the
+//! average converges to the true image. A pass depends only on its index
+//! (random streams are keyed by pass, the radius schedule is global), and
+//! the passes' sums are exact ([`super::accumulation`]): any set of passes
+//! can be rendered anywhere, in any order, and added into the same image as
+//! one process would make.
 
 use super::accumulation::Accumulation;
 use super::error_estimate::{ErrorEstimate, Prediction};
+use super::method::RenderMethod;
 use super::render_pass;
 use crate::film::Film;
 use crate::interrupt;
@@ -85,36 +91,88 @@ pub struct PassReport<'a> {
     pub predictions: Vec<(String, Prediction)>,
 }
 
-/// A progressive render's result.
+/// What a run renders.
+pub struct Plan {
+    /// Passes averaged into exact sums (progressive), or one pass whose
+    /// film is the image as rendered (a classic render).
+    pub progressive: bool,
+    /// The sums the passes are added to: empty, or a partial's (resumed).
+    pub start: Accumulation,
+    /// The first pass rendered.
+    pub first: u32,
+    pub budget: Budget,
+}
+
+impl Plan {
+    /// A classic render: pass 0, as rendered.
+    pub fn single(width: u32, height: u32) -> Plan {
+        Plan { progressive: false, start: Accumulation::new(width, height), first: 0, budget: Budget::passes(1) }
+    }
+
+    /// A progressive render from pass `first` on, added to `start`, until
+    /// `budget` says stop.
+    pub fn passes(start: Accumulation, first: u32, budget: Budget) -> Plan {
+        Plan { progressive: true, start, first, budget }
+    }
+}
+
+/// Sees each pass of a progressive render; may stop it.
+pub trait Observer {
+    /// After each pass, the running average and its estimate.
+    fn pass(&mut self, report: &PassReport) -> ControlFlow<()>;
+
+    /// The render has stopped (a display closes).
+    fn finish(&mut self) {}
+}
+
+impl<F: FnMut(&PassReport) -> ControlFlow<()>> Observer for F {
+    fn pass(&mut self, report: &PassReport) -> ControlFlow<()> {
+        self(report)
+    }
+}
+
+/// A run's result.
 pub struct Run {
     pub accumulation: Accumulation,
     pub stats: Stats,
     pub stopped: Stopped,
     pub error: Option<ErrorEstimate>,
     pub predictions: Vec<(String, Prediction)>,
+    /// A classic render's film, as rendered.
+    single: Option<Film>,
 }
 
 impl Run {
+    /// The image: the passes' average, or a classic render's pass.
     pub fn film(&self) -> Film {
-        self.accumulation.average()
+        match &self.single {
+            Some(film) => film.clone(),
+            None => self.accumulation.average(),
+        }
     }
 }
 
-/// Renders passes `first`, `first + 1`, … into `start` (empty for a new
-/// render, a partial's sums to resume one) until `budget` says stop;
-/// `on_pass` sees the running average after every pass and may stop the
-/// render.
-pub fn render_passes(
+/// Renders `plan` with `method` (its camera at `settings`' resolution).
+/// A classic render shows its phases' progress on `progress`; a
+/// progressive one reports each pass to `observers`, in order, after adding
+/// it (a pass cut short by an interrupt is not added).
+pub fn drive(
     scene: &Scene,
     settings: &Settings,
-    mut acc: Accumulation,
-    first: u32,
-    budget: &Budget,
-    mut on_pass: impl FnMut(&PassReport) -> ControlFlow<()>,
+    method: &dyn RenderMethod,
+    plan: Plan,
+    progress: Mode,
+    observers: &mut [&mut dyn Observer],
 ) -> Run {
+    if !plan.progressive {
+        let (film, stats) = render_pass(scene, settings, method, plan.first, progress, &mut None);
+        let stopped = if interrupt::requested() { Stopped::Interrupted } else { Stopped::Passes };
+        let (accumulation, error, predictions) = (plan.start, None, Vec::new());
+        return Run { accumulation, stats, stopped, error, predictions, single: Some(film) };
+    }
+    let Plan { start: mut acc, first, budget, .. } = plan;
     let start = Instant::now();
-    let model = settings.method.bias(settings.alpha);
-    let unit = settings.method.unit(settings);
+    let model = method.method().bias(settings.alpha);
     let mut stats = Stats::default();
     let mut pass = first;
     let mut last_pass_time = Duration::ZERO;
@@ -145,7 +203,7 @@ pub fn render_passes(
             }
         }
         let t = Instant::now();
-        let (film, pass_stats) = render_pass(scene, settings, unit.as_ref(), pass, Mode::Quiet, &mut rims);
+        let (film, pass_stats) = render_pass(scene, settings, method, pass, Mode::Quiet, &mut rims);
         if interrupt::requested() {
             // The pass was cut short: not a pass of the image.
             break Stopped::Interrupted;
@@ -157,7 +215,7 @@ pub fn render_passes(
         error = ErrorEstimate::new(&acc, model);
         predictions = predict(error.as_ref(), &budget.windows);
         let average = acc.average();
-        let flow = on_pass(&PassReport {
+        let report = PassReport {
             film: &average,
             accumulation: &acc,
             passes: acc.passes.count(),
@@ -170,12 +228,37 @@ pub fn render_passes(
             k_global: stats.k_global,
             error: error.as_ref(),
             predictions: predictions.clone(),
-        });
-        if flow.is_break() {
+        };
+        // Every observer sees every pass, whichever asks to stop.
+        let mut stop = false;
+        for o in observers.iter_mut() {
+            stop |= o.pass(&report).is_break();
+        }
+        if stop {
             break Stopped::Caller;
         }
     };
-    Run { accumulation: acc, stats, stopped, error, predictions }
+    for o in observers.iter_mut() {
+        o.finish();
+    }
+    Run { accumulation: acc, stats, stopped, error, predictions, single: None }
+}
+
+/// Renders passes `first`, `first + 1`, … into `acc` (empty for a new
+/// render, a partial's sums to resume one) until `budget` says stop;
+/// `on_pass` sees the running average after every pass and may stop the
+/// render.
+pub fn render_passes(
+    scene: &Scene,
+    settings: &Settings,
+    acc: Accumulation,
+    first: u32,
+    budget: &Budget,
+    mut on_pass: impl FnMut(&PassReport) -> ControlFlow<()>,
+) -> Run {
+    let method = settings.method.unit(settings);
+    let plan = Plan::passes(acc, first, budget.clone());
+    drive(scene, settings, method.as_ref(), plan, Mode::Quiet, &mut [&mut on_pass])
 }
 
 /// The whole image's predicted error, then each window's (nothing without

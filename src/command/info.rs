@@ -2,23 +2,15 @@
 //! how it was made (the header attributes photonmap writes), and for a
 //! partial render its manifest.
 
-use photonmap::error::Error;
-use photonmap::output::partial::{read_partial, Manifest};
-use photonmap::output::{read_exr, read_header};
+use crate::error::Error;
+use crate::output::partial::{read_partial, Manifest};
+use crate::output::{read_exr, read_header};
 use std::path::PathBuf;
 
-/// Prints an EXR's size, channels and provenance (program, scene and its
-/// hash, integrator, seed, photons, passes, spp, wall time), and a partial
-/// render's parts.
-#[derive(clap::Args, Debug)]
-pub struct Args {
-    #[arg(required = true, value_name = "FILE.exr")]
-    files: Vec<PathBuf>,
-}
-
-pub fn run(args: Args) -> Result<(), Error> {
+/// Prints what each file is.
+pub fn run(files: &[PathBuf]) -> Result<(), Error> {
     let mut unreadable = Vec::new();
-    for (i, path) in args.files.iter().enumerate() {
+    for (i, path) in files.iter().enumerate() {
         let h = read_header(path)?;
         if i > 0 {
             println!();
