@@ -232,8 +232,11 @@ fn texture_refusals_are_located() {
     let dir = scratch_dir("mitsuba_texture_refusals");
     let cases = [
         (r#"<bsdf type="diffuse"><texture name="reflectance" type="noise"/></bsdf>"#, "texture 'noise'"),
-        (r#"<bsdf type="mask"><bsdf type="conductor"/></bsdf>"#, "a mask is supported over a diffuse BSDF"),
-        (r#"<bsdf type="blendbsdf"><bsdf type="diffuse"/><bsdf type="plastic"/></bsdf>"#, "two diffuse BSDFs"),
+        (
+            r#"<bsdf type="mask"><bsdf type="normalmap"><texture name="normalmap" type="checkerboard"/><bsdf type="conductor"/></bsdf></bsdf>"#,
+            "a normal or bump map inside a blend or mask",
+        ),
+        (r#"<bsdf type="blendbsdf"><bsdf type="diffuse"/></bsdf>"#, "needs two nested <bsdf>"),
         (
             r#"<bsdf type="diffuse"><texture name="reflectance" type="bitmap"><string name="filename" value="none.png"/></texture></bsdf>"#,
             "none.png",

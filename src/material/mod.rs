@@ -40,6 +40,7 @@
 //! from the normal: meshes carry no texture-space tangents yet). Mitsuba's
 //! defaults are in [`defaults`].
 
+mod blend;
 mod conductor;
 mod dielectric;
 pub mod disney;
@@ -53,6 +54,7 @@ mod principled;
 mod principled_thin;
 mod textured;
 
+pub use blend::{hit_random, Blend, Mix};
 pub use conductor::{Conductor, RoughConductor};
 pub use dielectric::{RoughDielectric, ThinDielectric};
 pub use glossy::{Glossy, CAUSTIC_ROUGHNESS};
@@ -122,6 +124,10 @@ pub enum Material {
     Principled(Principled),
     /// Mitsuba's thin principled BSDF: a sheet, the same from both sides.
     PrincipledThin(PrincipledThin),
+    /// A blend of two of the scene's materials, as the scene sees it as a
+    /// whole ([`Blend`]); where a ray or photon meets it, the scene gives
+    /// one of the two.
+    Blend(Blend),
     /// A light's own surface: it emits (through its light) and reflects nothing.
     Emitter,
 }
@@ -308,6 +314,7 @@ impl Material {
             Material::Phong(p) => max_component(p.mirror_rho()) > 0.0,
             Material::Plastic(p) => max_component(p.specular) > 0.0,
             Material::Masked(m) => m.through() > 0.0,
+            Material::Blend(b) => b.specular,
             Material::RoughConductor(_)
             | Material::RoughDielectric(_)
             | Material::RoughPlastic(_)
@@ -329,6 +336,7 @@ impl Material {
             Material::Plastic(p) => p.diffuse,
             Material::RoughPlastic(p) => p.diffuse,
             Material::Masked(m) => m.rho(),
+            Material::Blend(b) => return b.diffuse,
             Material::Principled(p) => return p.diffuse_rho(),
             Material::PrincipledThin(p) => return p.diffuse_rho(),
             _ => return None,

@@ -27,7 +27,7 @@ impl Param {
 
     /// A number: a texture's `eval_1`.
     #[inline]
-    fn number(self, at: &SurfacePoint, textures: &[Texture]) -> f32 {
+    pub fn number(self, at: &SurfacePoint, textures: &[Texture]) -> f32 {
         match self {
             Param::Fixed(c) => c.x,
             Param::Texture(i) => textures[i as usize].eval_1(at),
@@ -36,7 +36,7 @@ impl Param {
 
     /// The value averaged over the texture (one half for a texture not
     /// in `textures`: a stand-in while a scene is read).
-    fn mean(self, textures: &[Texture]) -> Color {
+    pub fn mean(self, textures: &[Texture]) -> Color {
         match self {
             Param::Fixed(c) => c,
             Param::Texture(i) => textures.get(i as usize).map_or(Color::splat(0.5), Texture::mean),
@@ -106,6 +106,15 @@ pub enum Textured {
     },
     Principled(PrincipledRecipe),
     PrincipledThin(ThinRecipe),
+    /// A blend of two of the scene's materials (their indices), the
+    /// second's share `weight` (Mitsuba's `blendbsdf`; its `mask` is a blend
+    /// of `null` and the BSDF by the opacity): the scene gives one of them
+    /// where a ray or photon meets it ([`super::blend`]).
+    Blend {
+        weight: Param,
+        first: u32,
+        second: u32,
+    },
 }
 
 /// Mitsuba's `principled`: every parameter a texture may give, but the
@@ -195,6 +204,8 @@ impl Textured {
                 &[*diffuse, *specular]
             }
             Textured::Principled(r) => return r.params().iter().any(|p| p.is_texture()),
+            // Resolved where it is met, whether its weight is a texture or not.
+            Textured::Blend { .. } => return true,
             Textured::PrincipledThin(r) => return r.params().iter().any(|p| p.is_texture()),
         };
         params.iter().any(|p| p.is_texture())
@@ -270,6 +281,8 @@ impl Textured {
                 rates: r.rates,
                 back: false,
             }),
+            // The scene summarises the blend from its materials.
+            Textured::Blend { .. } => Material::Blend(super::Blend::default()),
             Textured::PrincipledThin(ref r) => Material::PrincipledThin(PrincipledThin {
                 base_color: unit(r.base_color),
                 roughness: weight(r.roughness),

@@ -291,7 +291,7 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
     let (frame, entering) = hit.scattering_frame(ray.dir, material);
     let first_specular = bounce_now == 0 && material.is_specular();
     let stop = (false, first_specular);
-    if material.diffuse_rho().is_some() {
+    if scene.stores_photons(&hit, material) {
         // Light reaching a diffuse surface straight from the light is
         // neither a caustic nor in the global map: shadow rays count it,
         // at the camera's points and at the irradiance cache's. After a

@@ -239,6 +239,27 @@ impl Texturing {
         }
     }
 
+    /// Material `m`, or where it is a blend, the material of it that `hit`
+    /// shows a ray travelling along `dir` (nests of blends followed down).
+    #[inline]
+    fn pick(&self, hit: &Hit, dir: Vec3, mut m: usize) -> usize {
+        let mut depth = 0;
+        // The front-ends make no cycle; the bound keeps a malformed one finite.
+        while let Some(Some(crate::material::Textured::Blend { weight, first, second })) = self.materials.get(m) {
+            if depth == 64 {
+                break;
+            }
+            let w = match weight {
+                crate::material::Param::Fixed(c) => c.x,
+                p => p.number(&self.point(hit), &self.textures),
+            };
+            let mix = crate::material::hit_random(hit.point, dir, depth);
+            m = if mix < w { *second } else { *first } as usize;
+            depth += 1;
+        }
+        m
+    }
+
     /// Where textures are read at `hit`.
     #[inline]
     pub fn point(&self, hit: &Hit) -> crate::texture::SurfacePoint {
@@ -335,6 +356,28 @@ fn specular_targets(prims: &[Prim], materials: &[Material]) -> Vec<Target> {
     targets.into_values().collect()
 }
 
+/// Each blend's summary from its materials' (blends nest: a blend's
+/// materials are summarised first).
+fn blend_summaries(materials: &mut [Material], texturing: &Texturing) {
+    use crate::material::{Blend, Textured};
+    fn summary(m: usize, materials: &[Material], texturing: &Texturing, depth: u32) -> Material {
+        match texturing.materials.get(m) {
+            Some(Some(Textured::Blend { weight, first, second })) if depth < 64 => {
+                let w = weight.mean(&texturing.textures).x.clamp(0.0, 1.0);
+                let a = summary(*first as usize, materials, texturing, depth + 1);
+                let b = summary(*second as usize, materials, texturing, depth + 1);
+                Material::Blend(Blend::of(w, &a, &b))
+            }
+            _ => materials[m],
+        }
+    }
+    for m in 0..materials.len() {
+        if matches!(texturing.materials.get(m), Some(Some(Textured::Blend { .. }))) {
+            materials[m] = summary(m, materials, texturing, 0);
+        }
+    }
+}
+
 impl Scene {
     /// Assembles a scene; the area lights are added as primitives too (after
     /// `parts.prims`, in order), so that camera rays see them and photons are
@@ -352,12 +395,13 @@ impl Scene {
             texturing,
         } = parts;
         // A textured material is its typical self wherever the scene asks
-        // about it as a whole.
+        // about it as a whole; a blend, what its materials are together.
         for (m, t) in materials.iter_mut().zip(&texturing.materials) {
             if let Some(t) = t {
                 *m = t.typical(&texturing.textures);
             }
         }
+        blend_summaries(&mut materials, &texturing);
         let mut texturing = texturing;
         let light_patterns = std::mem::take(&mut texturing.light_patterns);
         let texturing = texturing.is_used().then(|| Box::new(texturing));
@@ -542,22 +586,43 @@ impl Scene {
     }
 
     /// The material a ray travelling along `dir` meets at `hit`: a one-sided
-    /// material's black back where it arrives behind the geometric normal.
+    /// material's black back where it arrives behind the geometric normal;
+    /// where the primitive's material is a blend, one of its materials
+    /// ([`crate::material::Blend`]).
     #[inline]
     pub fn material_seen(&self, hit: &Hit, dir: Vec3) -> Material {
-        let m = self.prim_material[hit.prim as usize] as usize;
-        let back = !(self.back_material.is_empty() || dir.dot(hit.normal) < 0.0) && self.back_material[m] as usize != m;
+        let mut m = self.prim_material[hit.prim as usize] as usize;
         if let Some(t) = &self.texturing {
+            m = t.pick(hit, dir, m);
+            let back = self.seen_from_behind(hit, dir, m);
             if let Some(Some(recipe)) = t.materials.get(m) {
                 let material = recipe.at(&t.point(hit), &t.textures);
                 return if back { material.back_side() } else { material };
             }
+            return self.materials[if back { self.back_material[m] as usize } else { m }];
         }
-        if back {
+        if self.seen_from_behind(hit, dir, m) {
             self.materials[self.back_material[m] as usize]
         } else {
             self.materials[m]
         }
+    }
+
+    /// Whether material `m` is one-sided and `dir` arrives behind it.
+    #[inline]
+    fn seen_from_behind(&self, hit: &Hit, dir: Vec3, m: usize) -> bool {
+        !(self.back_material.is_empty() || dir.dot(hit.normal) < 0.0) && self.back_material[m] as usize != m
+    }
+
+    /// Whether a photon arriving at `hit`, where it meets `seen`, is
+    /// stored: where `seen` has a diffuse lobe, and where the primitive's
+    /// material is a blend with a diffuse lobe in either of its materials,
+    /// whichever the photon met ([`crate::material::Blend`]).
+    #[inline]
+    pub fn stores_photons(&self, hit: &Hit, seen: &Material) -> bool {
+        seen.diffuse_rho().is_some()
+            || (self.texturing.is_some()
+                && matches!(self.materials[self.prim_material[hit.prim as usize] as usize], Material::Blend(b) if b.diffuse.is_some()))
     }
 
     pub fn material(&self, prim: u32) -> &Material {

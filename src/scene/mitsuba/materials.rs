@@ -16,6 +16,9 @@ use crate::texture::Perturb;
 /// one-sided, and how it bends the shading normal.
 type Built = (Material, Option<Textured>, bool, Option<Perturb>);
 
+/// How deep BSDFs may nest (blends, masks, twosided, bump maps).
+const MAX_NESTING: u32 = 16;
+
 impl Builder<'_> {
     /// The material index of a shape's BSDF (`None`: Mitsuba's default).
     pub(super) fn material(&mut self, bsdf: Option<&Plugin>) -> Result<u32, SceneError> {
@@ -54,6 +57,29 @@ impl Builder<'_> {
     }
 
     fn bsdf_of(&mut self, p: &Plugin) -> Result<Built, SceneError> {
+        if self.bsdf_nesting >= MAX_NESTING {
+            return Err(p.refuse(format!("BSDFs nested more than {MAX_NESTING} deep (does one refer to itself?)")));
+        }
+        self.bsdf_nesting += 1;
+        let built = self.bsdf_nested(p);
+        self.bsdf_nesting -= 1;
+        built
+    }
+
+    /// The material index of a BSDF inside a blend or mask: its own
+    /// material (one-sided or not, textured or not), without a normal or
+    /// bump map of its own.
+    fn part(&mut self, q: &Plugin) -> Result<u32, SceneError> {
+        let m = self.material(Some(q))?;
+        if self.perturb[m as usize].is_some() {
+            return Err(
+                q.refuse("a normal or bump map inside a blend or mask is not supported (wrap the blend instead)")
+            );
+        }
+        Ok(m)
+    }
+
+    fn bsdf_nested(&mut self, p: &Plugin) -> Result<Built, SceneError> {
         let recipe = match p.kind {
             "diffuse" => {
                 let reflectance = self.reflectance(p, "reflectance", 0.5)?;
@@ -72,21 +98,14 @@ impl Builder<'_> {
                 let [a, b] = &inner[..] else {
                     return Err(p.refuse(format!("a blendbsdf needs two nested <bsdf>, got {}", inner.len())));
                 };
-                let mut diffuse = |q: &Plugin| -> Result<(Param, bool), SceneError> {
-                    match self.bsdf_of(q)? {
-                        (_, Some(Textured::Diffuse { reflectance }), one, None) => Ok((reflectance, one)),
-                        (Material::Lambertian { rho }, None, one, None) => Ok((Param::Fixed(rho), one)),
-                        _ => Err(q.refuse(format!(
-                            "a blendbsdf is supported for two diffuse BSDFs (a '{}' is not yet)",
-                            q.kind
-                        ))),
+                // Two diffuse BSDFs of the same sidedness blend exactly into
+                // one; any others are a blend the scene picks from per hit.
+                match (self.diffuse_part(a)?, self.diffuse_part(b)?) {
+                    (Some((first, one_a)), Some((second, one_b))) if one_a == one_b => {
+                        (Textured::DiffuseBlend { weight, first, second }, one_a)
                     }
-                };
-                let ((first, one_a), (second, one_b)) = (diffuse(a)?, diffuse(b)?);
-                if one_a != one_b {
-                    return Err(b.refuse("a blendbsdf of a one-sided and a two-sided BSDF is not supported"));
+                    _ => (Textured::Blend { weight, first: self.part(a)?, second: self.part(b)? }, false),
                 }
-                (Textured::DiffuseBlend { weight, first, second }, one_a)
             }
             "normalmap" | "bumpmap" => {
                 let perturb = if p.kind == "normalmap" {
@@ -133,12 +152,14 @@ impl Builder<'_> {
                 let [q] = &inner[..] else {
                     return Err(p.refuse(format!("a mask needs one nested <bsdf>, got {}", inner.len())));
                 };
-                match self.bsdf_of(q)? {
-                    (_, Some(Textured::Diffuse { reflectance }), one, None) => (Textured::Mask { opacity, reflectance }, one),
-                    (Material::Lambertian { rho }, None, one, None) => {
-                        (Textured::Mask { opacity, reflectance: Param::Fixed(rho) }, one)
+                match self.diffuse_part(q)? {
+                    Some((reflectance, one)) => (Textured::Mask { opacity, reflectance }, one),
+                    // Mitsuba's mask: the BSDF with chance `opacity`, else
+                    // nothing there (null).
+                    None => {
+                        let null = self.plain(Material::Masked(crate::material::Masked { opacity: 0.0, rho: Color::ZERO }));
+                        (Textured::Blend { weight: opacity, first: null, second: self.part(q)? }, false)
                     }
-                    _ => return Err(q.refuse(format!("a mask is supported over a diffuse BSDF (a '{}' is not yet)", q.kind))),
                 }
             }
             "dielectric" => {
@@ -226,7 +247,7 @@ impl Builder<'_> {
                 return match &inner[..] {
                     [one] => {
                         let (m, t, _, perturb) = self.bsdf_of(one)?;
-                        Ok((m, t, false, perturb))
+                        Ok((m, t.map(|t| self.two_sided(t)), false, perturb))
                     }
                     [_, two] => Err(two.refuse("a twosided BSDF with a different back BSDF is not supported yet")),
                     _ => Err(p.refuse("a twosided BSDF needs one nested <bsdf>")),
@@ -244,6 +265,50 @@ impl Builder<'_> {
         // A stand-in with the same lobes until the scene holds the textures.
         let material = textured.typical(&[]);
         Ok((material, textured.reads_textures().then_some(textured), one_sided, None))
+    }
+
+    /// A diffuse BSDF's reflectance and sidedness; `None` for any other.
+    fn diffuse_part(&mut self, q: &Plugin) -> Result<Option<(Param, bool)>, SceneError> {
+        Ok(match self.bsdf_of(q)? {
+            (_, Some(Textured::Diffuse { reflectance }), one, None) => Some((reflectance, one)),
+            (Material::Lambertian { rho }, None, one, None) => Some((Param::Fixed(rho), one)),
+            _ => None,
+        })
+    }
+
+    /// A recipe seen from both sides: a blend's materials made two-sided
+    /// too (copies, where they are one-sided), as Mitsuba's `twosided`
+    /// shows its BSDF's front on both sides whatever is inside.
+    fn two_sided(&mut self, t: Textured) -> Textured {
+        let Textured::Blend { weight, first, second } = t else { return t };
+        let mut both = |m: u32| -> u32 {
+            let k = m as usize;
+            if let Some(inner) = self.textured[k].clone() {
+                if matches!(inner, Textured::Blend { .. }) {
+                    let recipe = self.two_sided(inner);
+                    return self.add(self.materials[k], Some(recipe), false);
+                }
+            }
+            if !self.one_sided[k] {
+                return m;
+            }
+            self.add(self.materials[k], self.textured[k].clone(), false)
+        };
+        let (first, second) = (both(first), both(second));
+        Textured::Blend { weight, first, second }
+    }
+
+    fn add(&mut self, material: Material, textured: Option<Textured>, one_sided: bool) -> u32 {
+        self.materials.push(material);
+        self.textured.push(textured);
+        self.perturb.push(None);
+        self.one_sided.push(one_sided);
+        self.materials.len() as u32 - 1
+    }
+
+    /// A material of no BSDF element (two-sided, plain).
+    fn plain(&mut self, material: Material) -> u32 {
+        self.add(material, None, false)
     }
 
     /// A microfacet distribution as Mitsuba reads it: `distribution`

@@ -102,6 +102,7 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
         frames: Vec::new(),
         perturb: Vec::new(),
         light_patterns: Vec::new(),
+        bsdf_nesting: 0,
     };
     let mut camera: Option<(Camera, u32, f64, Plugin)> = None;
     let mut integrator_seen = false;
@@ -237,6 +238,9 @@ struct Builder<'a> {
     perturb: Vec<Option<crate::texture::Perturb>>,
     /// Per light, the image over a triangle light.
     light_patterns: Vec<Option<std::sync::Arc<crate::light::AreaPattern>>>,
+    /// How deep the BSDF being read is nested in others (a BSDF that
+    /// refers to itself would nest without end).
+    bsdf_nesting: u32,
 }
 
 impl Builder<'_> {
