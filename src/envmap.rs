@@ -123,6 +123,29 @@ impl EnvMap {
         self.total
     }
 
+    /// ∫ L(ω) |ω_k| dω for each world axis k, per channel: with a box's
+    /// face areas F_k, Σ F_k times these is the power the map sends
+    /// into the box (its shadow across ω has area Σ F_k |ω_k|). By the
+    /// midpoint rule on a grid twice as fine as the image: it only
+    /// apportions photons among lights, never their estimates.
+    pub fn abs_moments(&self) -> [Color; 3] {
+        let (nu, nv) = (2 * self.width, 2 * self.height.max(2));
+        let mut sum = [glam::DVec3::ZERO; 3];
+        for j in 0..nv {
+            let v = (j as f32 + 0.5) / nv as f32;
+            let w = (PI * v).sin() as f64 * 2.0 * std::f64::consts::PI.powi(2) / (nu * nv) as f64;
+            for i in 0..nu {
+                let uv = Vec2::new((i as f32 + 0.5) / nu as f32, v);
+                let l = self.lookup(uv).as_dvec3() * w;
+                let d = self.direction(uv).abs();
+                for (k, s) in sum.iter_mut().enumerate() {
+                    *s += l * d[k] as f64;
+                }
+            }
+        }
+        sum.map(|s| s.as_vec3())
+    }
+
     /// The map's texels (scaled) and its frame, as it was made.
     pub fn image(&self) -> (Film, Mat3) {
         (Film { width: self.width as u32, height: self.height as u32, pixels: self.texels.clone() }, self.to_world)

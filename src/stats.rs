@@ -52,6 +52,9 @@ impl Counters {
 #[derive(Clone, Debug, Default)]
 pub struct Stats {
     pub global_emitted: u64,
+    /// Global-pass photons whose first ray met the scene (fewer than
+    /// emitted where light from outside misses it).
+    pub global_landed: u64,
     pub global_stored: usize,
     pub caustic_emitted: u64,
     pub caustic_stored: usize,
@@ -99,6 +102,7 @@ impl Stats {
     /// Adds another pass's counts and times (maps' sizes are the last pass's).
     pub fn absorb(&mut self, o: Stats) {
         self.global_emitted += o.global_emitted;
+        self.global_landed += o.global_landed;
         self.caustic_emitted += o.caustic_emitted;
         self.caustic_aimed_hits += o.caustic_aimed_hits;
         if self.caustic_targets.len() < o.caustic_targets.len() {

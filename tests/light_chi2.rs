@@ -301,8 +301,8 @@ fn photon_starts_follow_their_density() {
         let from = |d: Vec3| -> Ray {
             match light {
                 Light::Area(a) => Ray::new(a.surface.anchor(), d),
-                Light::Constant(c) => Ray::new(c.center - d * (2.0 * c.radius), d),
-                Light::Envmap(e) => Ray::new(e.center - d * (2.0 * e.radius), d),
+                Light::Constant(c) => Ray::new(c.reach.upstream(d), d),
+                Light::Envmap(e) => Ray::new(e.reach.upstream(d), d),
                 _ => Ray::new(Vec3::ZERO, d),
             }
         };
@@ -346,28 +346,50 @@ fn photon_starts_follow_their_density() {
                 }
                 continue;
             }
-            _ => {
-                // Parallel light: the disk across the photon's direction.
-                let disk_of = |d: Vec3| match light {
-                    Light::Directional(l) => (l.reach.0, l.reach.1),
-                    Light::Constant(c) => (c.center - d * (2.0 * c.radius), c.radius),
-                    Light::Envmap(e) => (e.center - d * (2.0 * e.radius), e.radius),
+            Light::Constant(_) | Light::Envmap(_) => {
+                // Light from infinity: along a fixed direction, starts
+                // uniform on the shadow of the scene's box, mapped onto a
+                // square of side 4 across the direction about the box's
+                // centre (the box of side 2 casts at most 2 √3 across).
+                let reach = match light {
+                    Light::Constant(c) => c.reach,
+                    Light::Envmap(e) => e.reach,
                     _ => unreachable!(),
                 };
-                // Each start mapped onto the square of its own direction's
-                // disk; the density there is the same for every direction.
+                let d = Vec3::new(0.3, -0.5, 0.8).normalize();
+                let f = Frame::from_normal(d);
+                let centre = reach.upstream(d);
+                let to_square = |p: Vec3| {
+                    let q = p - centre;
+                    Vec2::new((q.dot(f.s) + 2.0) / 4.0, (q.dot(f.t) + 2.0) / 4.0)
+                };
+                let mut rng = stream(43, Domain::Camera, i as u64);
+                let o = chi2.run_square(
+                    || reach.start(d, next_2d(&mut rng)).map(to_square),
+                    |u, v| {
+                        let p = centre + f.s * (4.0 * u as f32 - 2.0) + f.t * (4.0 * v as f32 - 2.0);
+                        light.pdf_le(&Ray::new(p, d)).0 as f64 * 16.0
+                    },
+                );
+                report(name, "photon starts on the box's shadow", &o, &mut failed);
+                continue;
+            }
+            _ => {
+                // Parallel light: the disk across the photon's direction.
+                let (c, radius) = match light {
+                    Light::Directional(l) => (l.reach.0, l.reach.1),
+                    _ => unreachable!(),
+                };
                 let fixed = match light {
                     Light::Directional(l) => l.direction,
-                    _ => Vec3::Z,
+                    _ => unreachable!(),
                 };
                 let o = chi2.run_square(
                     || {
                         let r = start();
-                        let (c, radius) = disk_of(r.dir);
                         Some(disk_to_square(c, r.dir, radius, r.origin))
                     },
                     |u, v| {
-                        let (c, radius) = disk_of(fixed);
                         let p = square_to_disk(c, fixed, radius, u, v);
                         light.pdf_le(&Ray::new(p, fixed)).0 as f64 * PI * (radius as f64).powi(2)
                     },
@@ -425,8 +447,8 @@ fn unplaced(light: &Light) -> Light {
 /// (times their number) over directions against the light's radiant
 /// intensity (a light from a point or a surface), or over the disk across
 /// parallel light against its irradiance there (directional), or over
-/// directions against the radiance of light from infinity times the
-/// disk's area (sky, environment map).
+/// directions against the radiance of light from infinity times the area
+/// of the scene box's shadow across them (sky, environment map).
 #[test]
 fn the_global_pass_emits_what_each_light_sends() {
     let lights = lights();
@@ -452,12 +474,16 @@ fn the_global_pass_emits_what_each_light_sends() {
                 )
             }
             Light::Constant(_) | Light::Envmap(_) => {
-                let r = match placed {
-                    Light::Constant(c) => c.radius,
-                    Light::Envmap(e) => e.radius,
+                // Across each direction, the box's shadow.
+                let reach = match placed {
+                    Light::Constant(c) => c.reach,
+                    Light::Envmap(e) => e.reach,
                     _ => unreachable!(),
-                } as f64;
-                chi2.run_weighted(|| next().map(|(ray, w)| (ray.dir, w)), |d| radiance_from(placed, -d) * PI * r * r)
+                };
+                chi2.run_weighted(
+                    || next().map(|(ray, w)| (ray.dir, w)),
+                    |d| radiance_from(placed, -d) * reach.area(d) as f64,
+                )
             }
             _ => chi2.run_weighted(|| next().map(|(ray, w)| (ray.dir, w)), |d| intensity(placed, d).unwrap()),
         };

@@ -1,26 +1,30 @@
 //! Radiance from an environment map at infinity (Mitsuba's `envmap`):
-//! directions drawn from the map by luminance, photons from a disk across
-//! them as for the constant sky.
+//! directions drawn from the map by luminance, photons from the scene's
+//! box as each direction sees it (infinity.rs), caustic photons aimed at
+//! the glass and mirrors along directions drawn from the map, so mostly
+//! from its bright parts, with the exact density.
 
-use super::{aimed_across, directional_reach, disk_pdf, disk_point, Aim, Aimed, Emitted, Incident, Source};
+use super::infinity::Reach;
+use super::{aimed_across, Aim, Aimed, Emitted, Incident, Source};
 use crate::envmap::EnvMap;
 use crate::math::{Color, Ray, Vertex};
 use crate::sampling::{next_2d, Rng};
 use glam::{Vec2, Vec3};
-use std::f32::consts::PI;
 use std::sync::Arc;
 
 #[derive(Clone, Debug)]
 pub struct Environment {
     pub map: Arc<EnvMap>,
-    pub center: Vertex,
-    pub radius: f32,
+    pub reach: Reach,
+    /// ∫ L |ω_k| dω per world axis ([`EnvMap::abs_moments`]).
+    moments: [Color; 3],
 }
 
 impl Environment {
-    /// Unplaced: [`Source::place`] gives it its disk.
+    /// Unplaced: [`Source::place`] gives it the scene's box.
     pub fn new(map: Arc<EnvMap>) -> Self {
-        Environment { map, center: Vec3::ZERO, radius: 0.0 }
+        let moments = map.abs_moments();
+        Environment { map, reach: Reach::default(), moments }
     }
 }
 
@@ -35,27 +39,26 @@ impl Source for Environment {
         self.map.pdf(dir)
     }
 
-    /// A direction drawn from the map; its photon carries L / (pdf ∫ L dω)
-    /// of the mean share, per channel.
+    /// A direction drawn from the map, a start on the box's shadow across
+    /// it: the photon carries L A / pdf, A the shadow's area, as its
+    /// share of the power the map sends into the box, per channel.
     #[inline]
     fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Emitted {
         let (towards, pdf) = self.map.sample(u_dir);
         let dir = -towards;
-        let total = self.map.total();
-        let l = self.map.eval(towards);
-        let weight = Color::new(
-            if total.x > 0.0 { l.x / (pdf * total.x) } else { 0.0 },
-            if total.y > 0.0 { l.y / (pdf * total.y) } else { 0.0 },
-            if total.z > 0.0 { l.z / (pdf * total.z) } else { 0.0 },
-        );
-        let origin = disk_point(self.center - dir * (2.0 * self.radius), dir, self.radius, u_pos);
+        let Some(origin) = self.reach.start(dir, u_pos) else {
+            return Emitted { ray: Ray::new(self.reach.upstream(dir), dir), departure: None, weight: Color::ZERO };
+        };
+        let flux = self.map.eval(towards) * (self.reach.area(dir) / pdf);
+        let power = self.power();
+        let share = |f: f32, p: f32| if p > 0.0 { f / p } else { 0.0 };
+        let weight = Color::new(share(flux.x, power.x), share(flux.y, power.y), share(flux.z, power.z));
         let weight = if pdf > 0.0 && weight.is_finite() { weight } else { Color::ZERO };
         Emitted { ray: Ray::new(origin, dir), departure: None, weight }
     }
 
     fn pdf_le(&self, ray: &Ray) -> (f32, f32) {
-        let plane = self.center - ray.dir * (2.0 * self.radius);
-        (disk_pdf(plane, ray.dir, self.radius, ray.origin), self.map.pdf(-ray.dir))
+        (self.reach.pdf(ray), self.map.pdf(-ray.dir))
     }
 
     /// A direction drawn from the map: a directional light of irradiance
@@ -67,12 +70,13 @@ impl Source for Environment {
             return None;
         }
         let direction = -towards;
-        let plane = self.center - direction * (2.0 * self.radius);
+        let plane = self.reach.upstream(direction);
         Some(aimed_across(direction, self.map.eval(towards) / pdf, plane, aim, rng))
     }
 
+    /// What the map sends into the scene's box: Σ_k F_k ∫ L |ω_k| dω.
     fn power(&self) -> Color {
-        self.map.total() * (PI * self.radius * self.radius)
+        self.reach.power(self.moments)
     }
 
     fn is_delta(&self) -> bool {
@@ -84,7 +88,7 @@ impl Source for Environment {
     }
 
     fn place(&mut self, lo: Vec3, hi: Vec3) {
-        (self.center, self.radius) = directional_reach(Vec3::ZERO, lo, hi);
+        self.reach = Reach::new(lo, hi);
     }
 
     /// Light from infinity keeps its radiance where the scene moves.

@@ -23,6 +23,7 @@
 mod area;
 mod directional;
 mod environment;
+pub mod infinity;
 mod point;
 mod projector;
 mod sky;

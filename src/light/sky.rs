@@ -1,12 +1,10 @@
 //! Light from everywhere: radiance arriving equally from every direction
-//! at infinity (Mitsuba's `constant`). Photons start on a disk facing their
-//! direction that covers the scene's bounding sphere (`center`, `radius`),
-//! outside it.
+//! at infinity (Mitsuba's `constant`). Photons travel along uniform
+//! directions from the scene's box as each direction sees it
+//! (infinity.rs).
 
-use super::{
-    aimed_across, directional_reach, disk_pdf, disk_point, Aim, Aimed, Emitted, Incident, MitsubaEmitter, MitsubaParam,
-    Source,
-};
+use super::infinity::Reach;
+use super::{aimed_across, Aim, Aimed, Emitted, Incident, MitsubaEmitter, MitsubaParam, Source};
 use crate::math::{Color, Frame, Ray, Vertex};
 use crate::sampling::{cosine_hemisphere, next_2d, uniform_cone, Rng};
 use glam::{Vec2, Vec3};
@@ -15,14 +13,13 @@ use std::f32::consts::PI;
 #[derive(Clone, Debug)]
 pub struct Constant {
     pub radiance: Color,
-    pub center: Vertex,
-    pub radius: f32,
+    pub reach: Reach,
 }
 
 impl Constant {
-    /// Unplaced: [`Source::place`] gives it its disk.
+    /// Unplaced: [`Source::place`] gives it the scene's box.
     pub fn new(radiance: Color) -> Self {
-        Constant { radiance, center: Vec3::ZERO, radius: 0.0 }
+        Constant { radiance, reach: Reach::default() }
     }
 }
 
@@ -43,18 +40,22 @@ impl Source for Constant {
         dir.dot(n).max(0.0) / PI
     }
 
-    /// Travelling along a uniform direction, from a uniform point of the
-    /// disk facing it beyond the bounding sphere.
+    /// Travelling along a uniform direction, from a point uniform on the
+    /// box's shadow across it: L 4π A of the power per photon.
     #[inline]
     fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Emitted {
         let dir = uniform_cone(u_dir, -1.0).normalize();
-        let origin = disk_point(self.center - dir * (2.0 * self.radius), dir, self.radius, u_pos);
-        Emitted { ray: Ray::new(origin, dir), departure: None, weight: Color::ONE }
+        let Some(origin) = self.reach.start(dir, u_pos) else {
+            return Emitted { ray: Ray::new(self.reach.upstream(dir), dir), departure: None, weight: Color::ZERO };
+        };
+        // L 4π A over the power L 2π Σ F_k.
+        let faces = self.reach.faces();
+        let weight = 2.0 * self.reach.area(dir) / (faces.x + faces.y + faces.z);
+        Emitted { ray: Ray::new(origin, dir), departure: None, weight: Color::splat(weight) }
     }
 
     fn pdf_le(&self, ray: &Ray) -> (f32, f32) {
-        let plane = self.center - ray.dir * (2.0 * self.radius);
-        (disk_pdf(plane, ray.dir, self.radius, ray.origin), 1.0 / (4.0 * PI))
+        (self.reach.pdf(ray), 1.0 / (4.0 * PI))
     }
 
     /// A uniform direction (pdf 1 / 4π), then as a directional light of
@@ -62,13 +63,15 @@ impl Source for Constant {
     #[inline]
     fn sample_le_towards(&self, aim: &impl Aim, rng: &mut Rng) -> Option<Aimed> {
         let direction = uniform_cone(next_2d(rng), -1.0).normalize();
-        let plane = self.center - direction * (2.0 * self.radius);
+        let plane = self.reach.upstream(direction);
         Some(aimed_across(direction, self.radiance * (4.0 * PI), plane, aim, rng))
     }
 
-    /// Through the disk πR², from every direction: L 4π πR².
+    /// Into the scene's box from every direction: ∫ L A(ω) dω = L 2π Σ F_k
+    /// (π L times the box's surface).
     fn power(&self) -> Color {
-        self.radiance * (4.0 * PI * PI * self.radius * self.radius)
+        let faces = self.reach.faces();
+        self.radiance * (2.0 * PI * (faces.x + faces.y + faces.z))
     }
 
     fn is_delta(&self) -> bool {
@@ -80,7 +83,7 @@ impl Source for Constant {
     }
 
     fn place(&mut self, lo: Vec3, hi: Vec3) {
-        (self.center, self.radius) = directional_reach(Vec3::ZERO, lo, hi);
+        self.reach = Reach::new(lo, hi);
     }
 
     /// Light from infinity keeps its radiance where the scene moves.

@@ -45,6 +45,8 @@ pub struct PassOutput {
     /// Caustic pass: per target ([`Scene::specular_targets`]), the photons
     /// aimed at it and those of them whose first hit was mirror or glass.
     pub aimed: Vec<[u64; 2]>,
+    /// Emitted photons whose first ray met the scene.
+    pub landed: u64,
 }
 
 /// What the tracing of a block counted.
@@ -53,6 +55,7 @@ struct Tally {
     rays: u64,
     first_specular: u64,
     aimed: Vec<[u64; 2]>,
+    landed: u64,
 }
 
 /// Traces `n` photons of `pass`; `on_block` is told the number of photons
@@ -64,11 +67,22 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
     if n == 0 || !emits || (pass == Pass::Caustic && scene.specular_targets().is_empty()) {
         return PassOutput { emitted: n, ..PassOutput::default() };
     }
-    let blocks = n.div_ceil(BLOCK);
     let domain = match pass {
         Pass::Global => Domain::GlobalPhotons,
         Pass::Caustic => Domain::CausticPhotons,
     };
+    // Asked for n photons, the global pass of a scene lit from outside
+    // emits as many more as miss it (measured by a pilot of first rays),
+    // so that its map holds what n would in a closed scene.
+    let asked = n;
+    let n = match pass {
+        Pass::Global if lit_from_outside(scene) => {
+            let landed = landing_fraction(scene, seed);
+            (n as f64 / landed.max(1.0 / MAX_EXTRA as f64)).ceil() as u64
+        }
+        _ => n,
+    };
+    let blocks = n.div_ceil(BLOCK);
     let per_block: Vec<(Vec<Photon>, Tally)> = (0..blocks)
         .into_par_iter()
         // Each thread traces into a buffer that has reached the size of its
@@ -77,8 +91,11 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
         // the next block starts in a fresh one of that capacity, whose pages
         // are faulted in only as photons are written.
         .map_init(Vec::new, |out: &mut Vec<Photon>, b| {
-            let tally = trace_range::<LANES>(scene, pass, n, seed, domain, b * BLOCK..((b + 1) * BLOCK).min(n), out);
-            on_block(((b + 1) * BLOCK).min(n) - b * BLOCK);
+            let (start, end) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
+            let tally = trace_range::<LANES>(scene, pass, n, seed, domain, start..end, out);
+            // Progress in the photons asked for.
+            let asked_by = |i: u64| (i as u128 * asked as u128 / n as u128) as u64;
+            on_block(asked_by(end) - asked_by(start));
             let capacity = out.capacity();
             (std::mem::replace(out, Vec::with_capacity(capacity)), tally)
         })
@@ -90,6 +107,7 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
         blocks.push(photons);
         output.rays += tally.rays;
         output.first_hit_specular += tally.first_specular;
+        output.landed += tally.landed;
         for (total, block) in output.aimed.iter_mut().zip(&tally.aimed) {
             total[0] += block[0];
             total[1] += block[1];
@@ -97,6 +115,36 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
     }
     output.photons = PhotonBlocks::new(blocks);
     output
+}
+
+/// At most this many times the photons asked for are emitted where most
+/// miss the scene.
+const MAX_EXTRA: u64 = 16;
+
+/// Photons of the pilot that measures what share of a pass lands.
+const PILOT: u64 = 4096;
+
+/// Whether light from infinity (a sky, an environment map) lights the
+/// scene: its photons come from outside, and some miss everything.
+fn lit_from_outside(scene: &Scene) -> bool {
+    scene.lights.iter().any(|l| matches!(l, crate::light::Light::Constant(_) | crate::light::Light::Envmap(_)))
+}
+
+/// The share of the global pass's photons whose first ray meets the
+/// scene, measured on a pilot of its own random streams (indices past any
+/// pass's), so the same seed gives the same count.
+fn landing_fraction(scene: &Scene, seed: u64) -> f64 {
+    let first = u64::MAX - PILOT;
+    let landed = (first..first + PILOT)
+        .into_par_iter()
+        .filter(|&i| {
+            let mut rng = stream(seed, Domain::GlobalPhotons, i);
+            emit(scene, Pass::Global, PILOT, &mut rng)
+                .1
+                .is_some_and(|(ray, dep, _)| scene.intersect(&ray, dep).is_some())
+        })
+        .count();
+    landed as f64 / PILOT as f64
 }
 
 /// A photon leaving its light: its ray, the departure and its power.
@@ -114,7 +162,10 @@ pub fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> (Option<usize>,
         Pass::Global => {
             // The light's natural distribution: each photon carries power / n.
             let e = light.sample_le(next_2d(rng), next_2d(rng));
-            (None, Some((e.ray, e.departure, light.power() * scale * e.weight)))
+            let power = light.power() * scale * e.weight;
+            // One that carries nothing is not traced (nor stored, where it
+            // would count among an estimate's k nearest).
+            (None, (max_component(power) > 0.0).then_some((e.ray, e.departure, power)))
         }
         Pass::Caustic => {
             let targets = scene.specular_targets();
@@ -258,7 +309,9 @@ fn trace_range<const L: usize>(
             alive = true;
             tally.rays += 1;
             let target = path.target;
-            let (go_on, first_specular) = step(scene, pass, path, out);
+            let first = path.bounce == 0;
+            let (go_on, first_specular, hit) = step(scene, pass, path, out);
+            tally.landed += (first && hit) as u64;
             if first_specular {
                 tally.first_specular += 1;
                 if let Some(t) = tally.aimed.get_mut(target as usize) {
@@ -277,20 +330,21 @@ fn trace_range<const L: usize>(
 
 /// Casts one segment of `path`: stores a photon where it lands on a diffuse
 /// surface and samples the next direction. Returns whether the path goes
-/// on, and whether this was the first segment and it hit a specular surface.
+/// on, whether this was the first segment and it hit a specular surface,
+/// and whether the segment met anything.
 #[inline(always)]
-fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (bool, bool) {
+fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (bool, bool, bool) {
     let Path { ray, departure, power, rng, bounce, specular_bounces, only_specular_so_far, .. } = path;
     let bounce_now = *bounce;
     *bounce += 1;
     let Some(hit) = scene.intersect(ray, *departure) else {
-        return (false, false);
+        return (false, false, false);
     };
     *power *= scene.transmittance(*departure, hit.t);
     let material = &scene.material_seen(&hit, ray.dir);
     let (frame, entering) = hit.scattering_frame(ray.dir, material);
     let first_specular = bounce_now == 0 && material.is_specular();
-    let stop = (false, first_specular);
+    let stop = (false, first_specular, true);
     if scene.stores_photons(&hit, material) {
         // Light reaching a diffuse surface straight from the light is
         // neither a caustic nor in the global map: shadow rays count it,
@@ -349,7 +403,7 @@ fn step(scene: &Scene, pass: Pass, path: &mut Path, out: &mut Vec<Photon>) -> (b
     }
     let (next, dep) = hit.spawn(dir);
     (*ray, *departure) = (next, Some(dep));
-    (true, first_specular)
+    (true, first_specular, true)
 }
 
 #[cfg(test)]

@@ -68,6 +68,13 @@ impl RenderMethod for PhotonMapping {
                 pct(s.caustic_aimed_hits, s.caustic_emitted)
             ),
         ];
+        // Light from outside: what share of the global pass met the scene.
+        if s.global_landed < s.global_emitted {
+            out.insert(
+                1,
+                format!("               {:.1}% of them landed on the scene", pct(s.global_landed, s.global_emitted)),
+            );
+        }
         if s.caustic_targets.len() > 1 {
             for (k, &(object, aimed, hit)) in s.caustic_targets.iter().enumerate().take(8) {
                 out.push(format!(
@@ -189,6 +196,7 @@ pub fn photon_pass(
     phase.finish();
     stats.photon_time += t.elapsed();
     stats.global_emitted += global.emitted;
+    stats.global_landed += global.landed;
     stats.caustic_emitted += caustic.emitted;
     stats.caustic_aimed_hits += caustic.first_hit_specular;
     let targets = scene.specular_targets();
