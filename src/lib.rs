@@ -33,6 +33,7 @@ pub mod interrupt;
 pub mod light;
 pub mod material;
 pub mod math;
+pub mod medium;
 pub mod memory;
 pub mod metrics;
 pub mod optics;

@@ -1,0 +1,325 @@
+//! Volumes: a medium's coefficients as functions of position, as Mitsuba 3
+//! defines its `constvolume` and `gridvolume` plugins (src/volumes/):
+//! each has a `to_world` transform placing its unit cube [0, 1]^3 in the
+//! scene; the cube's world bounds are where a heterogeneous medium's
+//! density lives (Mitsuba's `Volume::bbox`). A grid is looked up in the
+//! cube, trilinearly between cell centres or at the nearest cell, and
+//! outside [0, 1] by its wrap mode (clamp, repeat, mirror).
+
+use super::vol_file::VolGrid;
+use crate::math::{Color, Ray};
+use glam::{Affine3A, Vec3};
+use std::sync::Arc;
+
+/// How a grid is read between its cells (Mitsuba's `filter_type`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Filter {
+    Trilinear,
+    Nearest,
+}
+
+/// How a grid is read outside [0, 1]^3 (Mitsuba's `wrap_mode`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wrap {
+    Clamp,
+    Repeat,
+    Mirror,
+}
+
+impl Filter {
+    pub fn name(self) -> &'static str {
+        match self {
+            Filter::Trilinear => "trilinear",
+            Filter::Nearest => "nearest",
+        }
+    }
+}
+
+impl Wrap {
+    pub fn name(self) -> &'static str {
+        match self {
+            Wrap::Clamp => "clamp",
+            Wrap::Repeat => "repeat",
+            Wrap::Mirror => "mirror",
+        }
+    }
+}
+
+/// An axis-aligned box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub lo: Vec3,
+    pub hi: Vec3,
+}
+
+impl Aabb {
+    /// The world bounds of the unit cube under `to_world`.
+    pub fn of_unit_cube(to_world: &Affine3A) -> Aabb {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for i in 0..8 {
+            let c = Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32);
+            let p = to_world.transform_point3(c);
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        Aabb { lo, hi }
+    }
+
+    /// The part [t0, t1] of the ray's [0, t_max] inside the box (slab
+    /// test), `None` where the ray misses it.
+    #[inline]
+    pub fn clip(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
+        let inv = ray.dir.recip();
+        let a = (self.lo - ray.origin) * inv;
+        let b = (self.hi - ray.origin) * inv;
+        // NaN (0 * inf, a ray in a slab's plane) loses against any number
+        // in min / max, so such an axis cuts nothing.
+        let near = a.min(b);
+        let far = a.max(b);
+        let t0 = near.x.max(near.y).max(near.z).max(0.0);
+        let t1 = far.x.min(far.y).min(far.z).min(t_max);
+        (t0 <= t1).then_some((t0, t1))
+    }
+}
+
+/// A grid of values placed in the scene.
+#[derive(Clone, Debug)]
+pub struct Grid {
+    pub data: Arc<VolGrid>,
+    /// As the scene gave it (before `use_grid_bbox`).
+    pub to_world: Affine3A,
+    pub use_grid_bbox: bool,
+    pub filter: Filter,
+    pub wrap: Wrap,
+    /// World to the grid's unit cube.
+    to_local: Affine3A,
+    bbox: Aabb,
+}
+
+/// A function of position (Mitsuba's `Volume`).
+#[derive(Clone, Debug)]
+pub enum Volume {
+    /// One value everywhere; its unit cube still bounds a heterogeneous
+    /// medium whose extinction it is (Mitsuba's `constvolume`).
+    Constant {
+        value: Color,
+        to_world: Affine3A,
+    },
+    Grid(Grid),
+}
+
+impl Grid {
+    /// A grid under `to_world`; with `use_grid_bbox` the file's box is
+    /// mapped to the unit cube first (Mitsuba's `bbox_transform`). `None`
+    /// where either transform is singular.
+    pub fn new(
+        data: Arc<VolGrid>,
+        to_world: Affine3A,
+        use_grid_bbox: bool,
+        filter: Filter,
+        wrap: Wrap,
+    ) -> Option<Self> {
+        let mut placed = to_world;
+        if use_grid_bbox {
+            let (lo, hi) = (Vec3::from_array(data.bbox.0), Vec3::from_array(data.bbox.1));
+            let extent = hi - lo;
+            if !(extent.min_element() > 0.0) {
+                return None;
+            }
+            // to_local = scale(1 / extent) * translate(-lo) * to_local.
+            placed = to_world * Affine3A::from_translation(lo) * Affine3A::from_scale(extent);
+        }
+        if !(placed.matrix3.determinant().abs() > 0.0) {
+            return None;
+        }
+        let to_local = placed.inverse();
+        to_local.is_finite().then(|| Grid {
+            bbox: Aabb::of_unit_cube(&placed),
+            data,
+            to_world,
+            use_grid_bbox,
+            filter,
+            wrap,
+            to_local,
+        })
+    }
+
+    /// The value at world point `p`.
+    #[inline]
+    pub fn eval(&self, p: Vec3) -> Color {
+        let q = self.to_local.transform_point3(p);
+        let [nx, ny, nz] = self.data.res.map(|r| r as i32);
+        let channels = self.data.channels as usize;
+        let at = |x: i32, y: i32, z: i32| -> Color {
+            let (x, y, z) = (wrap(x, nx, self.wrap), wrap(y, ny, self.wrap), wrap(z, nz, self.wrap));
+            let i = ((z as usize * ny as usize + y as usize) * nx as usize + x as usize) * channels;
+            if channels == 1 {
+                Color::splat(self.data.data[i])
+            } else {
+                Color::new(self.data.data[i], self.data.data[i + 1], self.data.data[i + 2])
+            }
+        };
+        let res = Vec3::new(nx as f32, ny as f32, nz as f32);
+        match self.filter {
+            Filter::Nearest => {
+                let c = (q * res).floor();
+                at(c.x as i32, c.y as i32, c.z as i32)
+            }
+            Filter::Trilinear => {
+                // Between cell centres, at (i + 0.5) / res (drjit's texture lookup).
+                let f = q * res - Vec3::splat(0.5);
+                let c = f.floor();
+                let w = f - c;
+                let (x, y, z) = (c.x as i32, c.y as i32, c.z as i32);
+                let lerp = |a: Color, b: Color, t: f32| a + (b - a) * t;
+                let x00 = lerp(at(x, y, z), at(x + 1, y, z), w.x);
+                let x10 = lerp(at(x, y + 1, z), at(x + 1, y + 1, z), w.x);
+                let x01 = lerp(at(x, y, z + 1), at(x + 1, y, z + 1), w.x);
+                let x11 = lerp(at(x, y + 1, z + 1), at(x + 1, y + 1, z + 1), w.x);
+                lerp(lerp(x00, x10, w.y), lerp(x01, x11, w.y), w.z)
+            }
+        }
+    }
+}
+
+/// Cell index `i` of `n` read by wrap mode `mode`. Coordinates far outside
+/// the grid arrive as saturated integers and stay in range.
+#[inline]
+fn wrap(i: i32, n: i32, mode: Wrap) -> i32 {
+    match mode {
+        Wrap::Clamp => i.clamp(0, n - 1),
+        Wrap::Repeat => i.rem_euclid(n),
+        Wrap::Mirror => {
+            // ... 1 0 | 0 1 ... n-1 | n-1 n-2 ...
+            let period = i.rem_euclid(2 * n);
+            if period < n {
+                period
+            } else {
+                2 * n - 1 - period
+            }
+        }
+    }
+}
+
+impl Volume {
+    #[inline]
+    pub fn eval(&self, p: Vec3) -> Color {
+        match self {
+            Volume::Constant { value, .. } => *value,
+            Volume::Grid(g) => g.eval(p),
+        }
+    }
+
+    /// The largest value over the volume and its channels (Mitsuba's
+    /// `Volume::max`, a heterogeneous medium's majorant before its scale).
+    pub fn max(&self) -> f32 {
+        match self {
+            Volume::Constant { value, .. } => value.max_element(),
+            Volume::Grid(g) => g.data.max(),
+        }
+    }
+
+    /// The smallest value over the volume and its channels.
+    pub fn min(&self) -> f32 {
+        match self {
+            Volume::Constant { value, .. } => value.min_element(),
+            Volume::Grid(g) => g.data.data.iter().copied().fold(f32::INFINITY, f32::min),
+        }
+    }
+
+    /// The world bounds of the volume's unit cube.
+    pub fn bbox(&self) -> Aabb {
+        match self {
+            Volume::Constant { to_world, .. } => Aabb::of_unit_cube(to_world),
+            Volume::Grid(g) => g.bbox,
+        }
+    }
+
+    /// Whether the value is the same everywhere.
+    pub fn constant(&self) -> Option<Color> {
+        match self {
+            Volume::Constant { value, .. } => Some(*value),
+            Volume::Grid(_) => None,
+        }
+    }
+
+    /// The same volume in a scene whose lengths are multiplied by `s`.
+    pub fn scaled(&self, s: f32) -> Volume {
+        let scale = Affine3A::from_scale(Vec3::splat(s));
+        match self {
+            Volume::Constant { value, to_world } => Volume::Constant { value: *value, to_world: scale * *to_world },
+            Volume::Grid(g) => Volume::Grid(
+                Grid::new(g.data.clone(), scale * g.to_world, g.use_grid_bbox, g.filter, g.wrap)
+                    .unwrap_or_else(|| g.clone()),
+            ),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ramp(filter: Filter, wrap: Wrap) -> Grid {
+        // 4 x 2 x 2, one channel, value = x index.
+        let data = (0..16).map(|i| (i % 4) as f32).collect();
+        let vol = VolGrid { res: [4, 2, 2], channels: 1, bbox: ([0.0; 3], [1.0; 3]), data };
+        Grid::new(Arc::new(vol), Affine3A::IDENTITY, false, filter, wrap).unwrap()
+    }
+
+    /// Trilinear lookups run linearly between cell centres and clamp at
+    /// the edges; the nearest cell is the one holding the point.
+    #[test]
+    fn lookups_interpolate_between_cell_centres() {
+        let g = ramp(Filter::Trilinear, Wrap::Clamp);
+        let at = |x: f32| g.eval(Vec3::new(x, 0.3, 0.8)).x;
+        assert!((at(0.125) - 0.0).abs() < 1e-6);
+        assert!((at(0.25) - 0.5).abs() < 1e-6);
+        assert!((at(0.5) - 1.5).abs() < 1e-6);
+        assert!((at(0.875) - 3.0).abs() < 1e-6);
+        assert_eq!(at(0.99), 3.0);
+        assert_eq!(at(-5.0), 0.0);
+        let n = ramp(Filter::Nearest, Wrap::Clamp);
+        assert_eq!(n.eval(Vec3::new(0.49, 0.5, 0.5)).x, 1.0);
+        assert_eq!(n.eval(Vec3::new(0.51, 0.5, 0.5)).x, 2.0);
+        let r = ramp(Filter::Nearest, Wrap::Repeat);
+        assert_eq!(r.eval(Vec3::new(1.1, 0.5, 0.5)).x, 0.0);
+        assert_eq!(r.eval(Vec3::new(-0.1, 0.5, 0.5)).x, 3.0);
+        let m = ramp(Filter::Nearest, Wrap::Mirror);
+        assert_eq!(m.eval(Vec3::new(1.1, 0.5, 0.5)).x, 3.0);
+        assert_eq!(m.eval(Vec3::new(-0.1, 0.5, 0.5)).x, 0.0);
+        assert_eq!(m.eval(Vec3::new(-0.3, 0.5, 0.5)).x, 1.0);
+        // Trilinear with repeat blends the last cell into the first.
+        let t = ramp(Filter::Trilinear, Wrap::Repeat);
+        assert!((t.eval(Vec3::new(1.0, 0.5, 0.5)).x - 1.5).abs() < 1e-6);
+    }
+
+    /// to_world places the unit cube; use_grid_bbox first maps the file's
+    /// box onto it.
+    #[test]
+    fn transforms_place_the_grid() {
+        let data = (0..16).map(|i| (i % 4) as f32).collect();
+        let vol = Arc::new(VolGrid { res: [4, 2, 2], channels: 1, bbox: ([2.0, 0.0, 0.0], [6.0, 1.0, 1.0]), data });
+        let to_world = Affine3A::from_translation(Vec3::new(-0.5, 0.0, 0.0)) * Affine3A::from_scale(Vec3::splat(2.0));
+        let g = Grid::new(vol.clone(), to_world, false, Filter::Nearest, Wrap::Clamp).unwrap();
+        assert_eq!(g.bbox, Aabb { lo: Vec3::new(-0.5, 0.0, 0.0), hi: Vec3::new(1.5, 2.0, 2.0) });
+        assert_eq!(g.eval(Vec3::new(1.4, 1.0, 1.0)).x, 3.0);
+        let b = Grid::new(vol, Affine3A::IDENTITY, true, Filter::Nearest, Wrap::Clamp).unwrap();
+        assert_eq!(b.bbox, Aabb { lo: Vec3::new(2.0, 0.0, 0.0), hi: Vec3::new(6.0, 1.0, 1.0) });
+        assert_eq!(b.eval(Vec3::new(4.5, 0.5, 0.5)).x, 2.0);
+    }
+
+    #[test]
+    fn a_box_clips_rays_to_its_inside() {
+        let b = Aabb { lo: Vec3::splat(-1.0), hi: Vec3::splat(1.0) };
+        let r = Ray::new(Vec3::new(-3.0, 0.0, 0.0), Vec3::X);
+        assert_eq!(b.clip(&r, 10.0), Some((2.0, 4.0)));
+        assert_eq!(b.clip(&r, 3.0), Some((2.0, 3.0)));
+        assert_eq!(b.clip(&r, 1.0), None);
+        let inside = Ray::new(Vec3::ZERO, Vec3::Y);
+        assert_eq!(b.clip(&inside, 10.0), Some((0.0, 1.0)));
+        let miss = Ray::new(Vec3::new(-3.0, 2.0, 0.0), Vec3::X);
+        assert_eq!(b.clip(&miss, 10.0), None);
+    }
+}
