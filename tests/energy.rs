@@ -45,6 +45,7 @@ fn furnace_with(le: f32, rho: f32, sphere: Option<Material>) -> Scene {
         one_sided: Vec::new(),
         paths: photonmap::scene::PathLimits::default(),
         texturing: Default::default(),
+        media: Default::default(),
     })
 }
 

@@ -429,6 +429,7 @@ fn scene(lights: Vec<Light>, targets: &[(Vec3, f32)]) -> Scene {
         one_sided: Vec::new(),
         paths: PathLimits::default(),
         texturing: Default::default(),
+        media: Default::default(),
     })
 }
 

@@ -147,6 +147,7 @@ fn open_scene(paths: PathLimits) -> Scene {
         one_sided: Vec::new(),
         paths,
         texturing: Default::default(),
+        media: Default::default(),
     })
 }
 
@@ -311,6 +312,7 @@ fn rough_glass_in_a_furnace_sees_the_sky_through_itself() {
         one_sided: Vec::new(),
         paths: PathLimits::default(),
         texturing: Default::default(),
+        media: Default::default(),
     });
     let mean = |mis: bool| {
         let b = blocks(&PathIntegrator { scene: &scene, shadow_rays: 2, skip: true, mis }, &scene, 16, 50, 5);

@@ -83,6 +83,19 @@ pub fn load(req: &Request) -> Result<Loaded, Error> {
         }
     };
     wait.finish();
+    if scene.media().is_some() && method == Method::Photon {
+        // Photon mapping does not yet carry light through media.
+        if req.method == Some(Method::Photon) {
+            return Err(Error::Invalid(format!(
+                "{}: photon mapping does not render participating media yet; render with --integrator path",
+                id.name
+            )));
+        }
+        method = Method::Path;
+        if !req.quiet {
+            eprintln!("photonmap: {}: the scene has participating media: rendering with --integrator path", id.name);
+        }
+    }
     Ok(Loaded { scene, spp, id, method })
 }
 

@@ -30,6 +30,7 @@
 //! puts the origin at it and scales the scene up, so that the offset is
 //! about 8.9e-5 of the distance to the origin.
 
+use super::mitsuba_medium::interface_refs;
 use super::mitsuba_sensor::sensor;
 use super::ply::PlyMesh;
 use crate::camera::Camera;
@@ -75,7 +76,7 @@ impl Refusal {
 /// image is the same for every placement, up to Mitsuba's ray offsets.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Placement {
-    origin: Vec3,
+    pub(super) origin: Vec3,
     pub(super) scale: f32,
 }
 
@@ -142,23 +143,36 @@ pub fn to_mitsuba(
         }
     }
     bsdfs += "    <bsdf type=\"diffuse\" id=\"black\"><rgb name=\"reflectance\" value=\"0, 0, 0\"/></bsdf>\n";
+    if !parts.media.media.is_empty() {
+        let (xml, files) = super::mitsuba_medium::media(&parts.media.media, mesh_dir, placement);
+        bsdfs += &xml;
+        out.meshes.extend(files);
+        out.media = true;
+    }
+    let interface = |list: &[Option<crate::medium::Interface>], i: usize| list.get(i).copied().flatten();
 
     // Geometry: a mesh per run of triangles of one object, material and
     // shading; analytic shapes one by one.
     let mut shapes = String::new();
     let mut run: Option<(u32, u32, PlyMesh)> = None;
-    let refs = |m: u32| material_refs(parts, m);
-    for p in &parts.prims {
+    let mut run_media = None;
+    let refs = |m: u32, media| {
+        material_refs(parts, m, media).map_err(|msg| refuse(place(&|o| o.materials.get(m as usize)), msg))
+    };
+    for (i, p) in parts.prims.iter().enumerate() {
+        let media = interface(&parts.media.prims, i);
         if let Shape::Triangle(t) = p.shape {
             let smooth = t.shading != FLAT;
-            let same = run
-                .as_ref()
-                .is_some_and(|(o, m, mesh)| *o == p.object && *m == p.material && mesh.is_smooth() == smooth);
+            let same = run_media == media
+                && run
+                    .as_ref()
+                    .is_some_and(|(o, m, mesh)| *o == p.object && *m == p.material && mesh.is_smooth() == smooth);
             if !same {
                 if let Some((_, m, mesh)) = run.take() {
-                    shapes += &out.mesh(mesh, &refs(m), "");
+                    shapes += &out.mesh(mesh, &refs(m, run_media)?, "");
                 }
                 run = Some((p.object, p.material, PlyMesh::new(smooth)));
+                run_media = media;
             }
             let normals = if smooth { parts.shading_normals[t.shading as usize] } else { [t.normal; 3] };
             if let Some((_, _, mesh)) = run.as_mut() {
@@ -167,28 +181,29 @@ pub fn to_mitsuba(
             continue;
         }
         if let Some((_, m, mesh)) = run.take() {
-            shapes += &out.mesh(mesh, &refs(m), "");
+            shapes += &out.mesh(mesh, &refs(m, run_media)?, "");
         }
+        let refs = |m: u32| refs(m, media);
         shapes += &match &p.shape {
             Shape::Sphere(sphere) => format!(
                 "    <shape type=\"sphere\">\n        <point name=\"center\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{}\"/>\n{}    </shape>\n",
                 xyz(at(sphere.center)),
                 sphere.radius * s,
-                refs(p.material)
+                refs(p.material)?
             ),
             Shape::Disk(d) => format!(
                 "    <shape type=\"disk\">\n        {}\n{}    </shape>\n",
                 disk_transform(at(d.center), d.normal, d.radius * s),
-                refs(p.material)
+                refs(p.material)?
             ),
-            Shape::Ellipsoid(e) => out.ellipsoid(e, &refs(p.material)),
+            Shape::Ellipsoid(e) => out.ellipsoid(e, &refs(p.material)?),
             Shape::Cylinder(c) => format!(
                 "    <shape type=\"cylinder\">\n        <point name=\"p0\" value=\"{}\"/>\n        <point name=\"p1\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{}\"/>\n        <boolean name=\"flip_normals\" value=\"{}\"/>\n{}    </shape>\n",
                 xyz(at(c.p0)),
                 xyz(at(c.p1())),
                 c.radius * s,
                 c.flip,
-                refs(p.material)
+                refs(p.material)?
             ),
             Shape::Ellipse(e) => {
                 let to_world = crate::shape::ellipse_to_world(e);
@@ -196,7 +211,7 @@ pub fn to_mitsuba(
                     * glam::DAffine3::from_translation(-placement.origin.as_dvec3())
                     * to_world;
                 let m = Affine3A::from_mat3_translation(placed.matrix3.as_mat3(), placed.translation.as_vec3());
-                format!("    <shape type=\"disk\">\n        {}\n{}    </shape>\n", matrix(&m), refs(p.material))
+                format!("    <shape type=\"disk\">\n        {}\n{}    </shape>\n", matrix(&m), refs(p.material)?)
             }
             Shape::Triangle(_) => unreachable!("handled above"),
             // A shape added to photonmap renders before the export knows
@@ -212,34 +227,38 @@ pub fn to_mitsuba(
         };
     }
     if let Some((_, m, mesh)) = run.take() {
-        shapes += &out.mesh(mesh, &refs(m), "");
+        shapes += &out.mesh(mesh, &refs(m, run_media)?, "");
     }
 
     // Lights: area lights are shapes with an emitter (a run of emissive
     // triangles of one shape is one mesh).
     let mut emitters = String::new();
-    let mut tri_run: Option<(usize, Color, Option<u32>, PlyMesh)> = None;
-    let flush = |out: &mut Exporter, tri_run: &mut Option<(usize, Color, Option<u32>, PlyMesh)>| {
-        tri_run.take().map_or(String::new(), |(_, radiance, material, mesh)| {
+    type TriRun = (usize, Color, Option<u32>, Option<crate::medium::Interface>, PlyMesh);
+    let mut tri_run: Option<TriRun> = None;
+    let flush = |out: &mut Exporter, tri_run: &mut Option<TriRun>| {
+        tri_run.take().map_or(String::new(), |(_, radiance, material, media, mesh)| {
             let emitter = format!(
                 "        <emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>\n",
                 rgb(radiance)
             );
-            out.mesh(mesh, &bsdf_ref(material), &emitter)
+            out.mesh(mesh, &(bsdf_ref(material) + &interface_refs(media)), &emitter)
         })
     };
     for (i, l) in parts.lights.iter().enumerate() {
         let light_place = || place(&|o| o.lights.get(i));
+        let media = interface(&parts.media.lights, i);
         match l {
             Light::Area(AreaLight { surface: Emitting::Triangle(t), radiance, material, .. }) => {
                 let (t, radiance, material) = (*t, *radiance, *material);
                 let key = origins.and_then(|o| o.lights.get(i)).map_or(usize::MAX, |p| p.line);
-                let same = tri_run.as_ref().is_some_and(|(k, r, m, _)| *k == key && *r == radiance && *m == material);
+                let same = tri_run
+                    .as_ref()
+                    .is_some_and(|(k, r, m, f, _)| *k == key && *r == radiance && *m == material && *f == media);
                 if !same {
                     emitters += &flush(&mut out, &mut tri_run);
-                    tri_run = Some((key, radiance, material, PlyMesh::new(false)));
+                    tri_run = Some((key, radiance, material, media, PlyMesh::new(false)));
                 }
-                if let Some((_, _, _, mesh)) = tri_run.as_mut() {
+                if let Some((_, _, _, _, mesh)) = tri_run.as_mut() {
                     mesh.push([t.v0, t.v1, t.v2].map(at), [t.normal; 3]);
                 }
             }
@@ -247,9 +266,10 @@ pub fn to_mitsuba(
                 emitters += &flush(&mut out, &mut tri_run);
                 let _ = write!(
                     emitters,
-                    "    <shape type=\"disk\">\n        {}\n{}        <emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>\n    </shape>\n",
+                    "    <shape type=\"disk\">\n        {}\n{}{}        <emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>\n    </shape>\n",
                     disk_transform(at(d.center), d.normal, d.radius * s),
                     bsdf_ref(*material),
+                    interface_refs(media),
                     rgb(*radiance)
                 );
             }
@@ -279,6 +299,14 @@ pub fn to_mitsuba(
     emitters += &flush(&mut out, &mut tri_run);
 
     let integrator = if out.media { "volpath" } else { "path" };
+    let camera = match parts.media.camera {
+        Some(m) => camera.replacen(
+            "</sensor>",
+            &format!("    <ref name=\"medium\" id=\"{}\"/>\n    </sensor>", super::mitsuba_medium::id(m)),
+            1,
+        ),
+        None => camera,
+    };
     let (w, h) = (parts.camera.width, parts.camera.height);
     let mut xml = String::new();
     let _ = write!(
@@ -355,13 +383,20 @@ impl Exporter<'_> {
     }
 }
 
-/// References to material `m`'s BSDF and, for absorbing glass, its medium.
-fn material_refs(parts: &SceneParts, m: u32) -> String {
+/// References to material `m`'s BSDF and, for absorbing glass, its
+/// medium; or the media the shape bounds (not both: a body of absorbing
+/// glass is its own medium).
+fn material_refs(parts: &SceneParts, m: u32, media: Option<crate::medium::Interface>) -> Result<String, String> {
     let mut s = format!("        <ref id=\"material{m}\"/>\n");
     if parts.materials[m as usize].absorption().is_some() {
+        if media.is_some() {
+            return Err("absorbing glass that also bounds a medium has no equivalent in Mitsuba 3 (a shape has one \
+                        interior); give the medium the absorption instead"
+                .to_string());
+        }
         s += &format!("        <ref name=\"interior\" id=\"medium{m}\"/>\n");
     }
-    s
+    Ok(s + &interface_refs(media))
 }
 
 fn bsdf_ref(material: Option<u32>) -> String {
@@ -515,6 +550,7 @@ mod tests {
             one_sided: Vec::new(),
             paths: crate::scene::PathLimits::default(),
             texturing: Default::default(),
+            media: Default::default(),
         }
     }
 

@@ -93,6 +93,13 @@ pub(super) fn bsdf(m: &Material, id: &str) -> Option<String> {
                 p.nonlinear
             ),
         ),
+        // Nothing there: an index-matched boundary (a medium's).
+        Material::Masked(m) if m.opacity == 0.0 => format!("    <bsdf type=\"null\" id=\"{id}\"/>\n"),
+        Material::Masked(m) => format!(
+            "    <bsdf type=\"mask\" id=\"{id}\">{}<bsdf type=\"twosided\"><bsdf type=\"diffuse\">{}</bsdf></bsdf></bsdf>\n",
+            float("opacity", m.opacity),
+            rgb("reflectance", m.rho)
+        ),
         _ => return None,
     })
 }

@@ -3,5 +3,6 @@
 
 pub mod mitsuba;
 mod mitsuba_bsdf;
+mod mitsuba_medium;
 mod mitsuba_sensor;
 mod ply;

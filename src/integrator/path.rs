@@ -41,6 +41,9 @@ impl Integrator for PathIntegrator<'_> {
     type Pixel = ();
 
     fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context, _: &mut (), _: &mut ()) -> Color {
+        if let Some(media) = self.scene.media() {
+            return super::volpath::radiance(self, media, ray, part, ctx);
+        }
         let mut radiance = Color::ZERO;
         let mut throughput = Color::ONE;
         let (mut ray, mut departure) = (ray, None);

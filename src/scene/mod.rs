@@ -195,6 +195,9 @@ pub struct Scene {
     /// Textures and the materials that read them; `None` in a scene
     /// without textures, which then pays nothing for them.
     texturing: Option<Box<Texturing>>,
+    /// Participating media; `None` in a scene without, which then pays
+    /// nothing for them.
+    media: Option<Box<crate::medium::Media>>,
 }
 
 /// A scene's textures ([`crate::texture`]): the textures, the materials
@@ -299,6 +302,8 @@ pub struct SceneParts {
     pub paths: PathLimits,
     /// Textures (empty: none).
     pub texturing: Texturing,
+    /// Participating media and the shapes that bound them (empty: none).
+    pub media: crate::medium::MediaParts,
 }
 
 /// What the scene says of the light paths to render (Mitsuba's
@@ -328,6 +333,9 @@ impl SceneParts {
             *f *= shrink;
         }
         self.camera = self.camera.scaled(s);
+        for m in &mut self.media.media {
+            *m = m.scaled(s);
+        }
         self
     }
 }
@@ -378,6 +386,30 @@ fn blend_summaries(materials: &mut [Material], texturing: &Texturing) {
     }
 }
 
+/// The media of a scene's parts, with an interface per primitive of the
+/// scene (`prims` of the parts', then the area lights' in the order of
+/// their specs): `None` where the scene has no media, or nothing
+/// refers to them.
+fn place_media(
+    parts: crate::medium::MediaParts,
+    parts_prims: usize,
+    prims: usize,
+    specs: &[Light],
+) -> Option<Box<crate::medium::Media>> {
+    let crate::medium::MediaParts { media, prims: mut interfaces, lights, camera } = parts;
+    if media.is_empty() {
+        return None;
+    }
+    interfaces.resize(parts_prims, None);
+    let area_lights = specs.iter().enumerate().filter(|(_, s)| matches!(s, Light::Area(_)));
+    for (i, _) in area_lights {
+        interfaces.push(lights.get(i).copied().flatten());
+    }
+    interfaces.resize(prims, None);
+    let used = camera.is_some() || interfaces.iter().any(Option::is_some);
+    used.then(|| Box::new(crate::medium::Media::new(media, interfaces, camera)))
+}
+
 impl Scene {
     /// Assembles a scene; the area lights are added as primitives too (after
     /// `parts.prims`, in order), so that camera rays see them and photons are
@@ -393,6 +425,7 @@ impl Scene {
             one_sided,
             paths,
             texturing,
+            media,
         } = parts;
         // A textured material is its typical self wherever the scene asks
         // about it as a whole; a blend, what its materials are together.
@@ -428,6 +461,7 @@ impl Scene {
         } else {
             Vec::new()
         };
+        let parts_prims = prims.len();
         let mut prim_light = vec![NO_LIGHT; prims.len()];
         let mut lights = Vec::new();
         let emitter = materials.len() as u32;
@@ -451,6 +485,7 @@ impl Scene {
             lo = lo.min(a);
             hi = hi.max(b);
         }
+        let media = place_media(media, parts_prims, prims.len(), &specs);
         lights.extend(specs.into_iter().filter(|l| l.area().is_none()));
         // Light from infinity starts its photons outside everything else.
         let (lo, hi) = crate::light::place_lights(&mut lights, lo, hi);
@@ -480,7 +515,14 @@ impl Scene {
             paths,
             at_infinity,
             texturing,
+            media,
         }
+    }
+
+    /// The scene's participating media, if it has any.
+    #[inline]
+    pub fn media(&self) -> Option<&crate::medium::Media> {
+        self.media.as_deref()
     }
 
     /// Radiance arriving along a ray travelling along `dir` that leaves the
@@ -496,7 +538,13 @@ impl Scene {
 
     #[inline]
     pub fn intersect(&self, ray: &Ray, departure: Option<Departure>) -> Option<Hit> {
-        self.accel.closest_hit(ray, departure, f32::INFINITY).map(|(prim, h)| {
+        self.intersect_within(ray, departure, f32::INFINITY)
+    }
+
+    /// The nearest hit closer than `t_max`.
+    #[inline]
+    pub fn intersect_within(&self, ray: &Ray, departure: Option<Departure>, t_max: f32) -> Option<Hit> {
+        self.accel.closest_hit(ray, departure, t_max).map(|(prim, h)| {
             let mut hit = Hit {
                 t: h.t,
                 point: h.point,
@@ -706,6 +754,12 @@ impl Scene {
         let i = lights.sample(u).0;
         let p = lights.prob(i);
         (p > 0.0).then_some((i, p))
+    }
+
+    /// The chance that [`Self::pick_light_index`] picks light `index`.
+    #[inline]
+    pub fn light_prob(&self, index: usize) -> f32 {
+        self.light_pick.as_ref().map_or(0.0, |l| l.prob(index))
     }
 
     /// What light `index`'s own sampling density is multiplied by in the

@@ -130,6 +130,7 @@ impl Scene {
             one_sided: Vec::new(),
             paths: crate::scene::PathLimits::default(),
             texturing: Default::default(),
+            media: Default::default(),
         }
     }
 }

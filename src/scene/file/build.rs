@@ -171,6 +171,7 @@ impl<'a> Builder<'a> {
             one_sided: Vec::new(),
             paths: crate::scene::PathLimits::default(),
             texturing: Default::default(),
+            media: Default::default(),
         };
         Ok(SceneFile {
             parts,

@@ -22,6 +22,7 @@ pub mod conductors;
 mod emitters;
 mod film;
 mod materials;
+mod media;
 mod principled;
 pub mod props;
 mod sensor;
@@ -103,6 +104,7 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
         perturb: Vec::new(),
         light_patterns: Vec::new(),
         bsdf_nesting: 0,
+        media: Default::default(),
     };
     let mut camera: Option<(Camera, u32, f64, Plugin)> = None;
     let mut integrator_seen = false;
@@ -115,6 +117,7 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
                 if camera.is_some() {
                     return Err(p.refuse("photonmap renders one sensor; this scene has a second"));
                 }
+                b.sensor_medium(&p)?;
                 let (c, spp, far) = sensor::camera(&p)?;
                 b.origins.camera = place(&p);
                 camera = Some((c, spp, far, p));
@@ -128,24 +131,18 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
                 b.integrator(&p)?;
             }
             // Declared for reference elsewhere: read where used.
-            "bsdf" | "texture" | "spectrum" => {
+            "bsdf" | "texture" | "spectrum" | "medium" | "phase" | "volume" => {
                 if el.attr("id").is_none() {
                     return Err(xml::error(&el.loc, &el.tag, format!("a top-level <{}> needs an id", el.tag)));
                 }
-            }
-            "medium" | "phase" | "volume" => {
-                let p = Plugin::new(el, &ids)?;
-                return Err(p.refuse(format!(
-                    "participating media are not supported yet (the <{}> '{}' plugin)",
-                    el.tag, p.kind
-                )));
             }
             t => {
                 return Err(xml::error(
                     &el.loc,
                     t,
                     format!(
-                    "<{t}> is not a scene element photonmap reads (shape, bsdf, emitter, sensor, integrator, texture)"
+                    "<{t}> is not a scene element photonmap reads (shape, bsdf, emitter, sensor, integrator, texture, \
+                     medium, phase, volume)"
                 ),
                 ))
             }
@@ -171,6 +168,7 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
         ));
     }
     let texturing = b.texturing();
+    let media = b.media_parts();
     let parts = SceneParts {
         prims: b.prims,
         shading_normals: b.shading_normals,
@@ -181,6 +179,7 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
         one_sided: b.one_sided,
         paths: super::PathLimits { max_depth: b.max_depth, hide_emitters: b.hide_emitters },
         texturing,
+        media,
     };
     let file = SceneFile {
         parts,
@@ -241,6 +240,7 @@ struct Builder<'a> {
     /// How deep the BSDF being read is nested in others (a BSDF that
     /// refers to itself would nest without end).
     bsdf_nesting: u32,
+    media: media::MediaDraft,
 }
 
 impl Builder<'_> {

@@ -232,6 +232,32 @@ impl<'a> Plugin<'a> {
         Ok(out)
     }
 
+    /// The nested objects of tag `tag` with the name each is given (a
+    /// `<ref name="interior" id="...">` or `<medium name="interior">`),
+    /// marked read.
+    pub fn named_objects(&self, tag: &str) -> Result<Vec<(Option<&'a str>, Plugin<'a>)>, SceneError> {
+        let mut out = Vec::new();
+        for (i, c) in self.el.children.iter().enumerate() {
+            let el = self.resolve(c)?;
+            if el.tag == tag {
+                self.used.borrow_mut()[i] = true;
+                out.push((c.attr("name"), Plugin::new(el, self.ids)?));
+            }
+        }
+        Ok(out)
+    }
+
+    /// The object child named `name` if it is a `<tag>` (through a
+    /// reference), marked read; `None` where there is no child of that
+    /// name or it is something else (left for the other readers).
+    pub fn object_named(&self, name: &str, tag: &str) -> Result<Option<Plugin<'a>>, SceneError> {
+        if self.tag_of(name) != Some(tag) {
+            return Ok(None);
+        }
+        let Some((_, el)) = self.named(name)? else { return Ok(None) };
+        Plugin::new(el, self.ids).map(Some)
+    }
+
     /// At most one nested object of tag `tag`.
     pub fn object(&self, tag: &str) -> Result<Option<Plugin<'a>>, SceneError> {
         let mut all = self.objects(tag)?;

@@ -70,9 +70,8 @@ impl Builder<'_> {
             }
             _ => {}
         }
-        if let Some(medium) = p.objects("medium")?.first() {
-            return Err(medium.refuse("participating media are not supported yet"));
-        }
+        let interface = self.interface(p)?;
+        let (prims, lights) = (self.prims.len(), self.lights.len());
         let bsdf = p.object("bsdf")?;
         let material = self.material(bsdf.as_ref())?;
         let emitter = p.object("emitter")?;
@@ -261,7 +260,7 @@ impl Builder<'_> {
                 )))
             }
         };
-        p.finish("filename, shape_index, face_normals, flip_normals, flip_tex_coords, to_world, center, radius, p0, p1, normals, bsdf, emitter")?;
+        p.finish("filename, shape_index, face_normals, flip_normals, flip_tex_coords, to_world, center, radius, p0, p1, normals, bsdf, emitter, interior, exterior")?;
         match mesh {
             Mesh::Analytic(shape) => match (radiance, shape) {
                 (None, shape) => {
@@ -289,6 +288,7 @@ impl Builder<'_> {
                 self.push_triangles(t, &to_world, flip, material, object, emits)
             }
         }
+        self.bind_media(interface, prims, lights);
         Ok(())
     }
 
