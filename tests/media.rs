@@ -480,3 +480,149 @@ fn media_export_and_import_agree() {
     let (ma, mb) = (mean(&fa), mean(&fb));
     assert!(((ma - mb) / ma).abs().max_element() < 0.01, "means {ma} and {mb}");
 }
+
+/// A scene file (TOML) with a homogeneous medium around the camera and a
+/// ball of heterogeneous smoke from a `.vol` grid inside it.
+fn toml_scene(media: &str, ball: &str) -> String {
+    format!(
+        r#"[camera]
+eye = [0, 0, 4]
+target = [0, 0, 0]
+up = [0, 1, 0]
+vfov = 40
+width = 16
+height = 16
+medium = "fog"
+
+[materials.boundary]
+type = "null"
+
+[materials.wall]
+type = "lambertian"
+rho = [0.5, 0.5, 0.5]
+
+{media}
+
+[[shapes]]
+type = "sphere"
+material = "boundary"
+center = [0, 0, 0]
+radius = 1
+{ball}
+
+[[shapes]]
+type = "quad"
+material = "wall"
+vertices = [[-3, -3, -2], [3, -3, -2], [3, 3, -2], [-3, 3, -2]]
+
+[[lights]]
+type = "point"
+position = [0, 2, 3]
+color = [5, 5, 5]
+"#
+    )
+}
+
+const TOML_MEDIA: &str = r#"[media.fog]
+type = "homogeneous"
+sigma_t = [0.1, 0.2, 0.3]
+albedo = [0.9, 0.9, 0.9]
+phase = { type = "hg", g = 0.3 }
+
+[media.smoke]
+type = "heterogeneous"
+sigma_t = { grid = "g.vol", transform = [{ scale = [2, 2, 2] }, { translate = [-1, -1, -1] }] }
+scale = 2
+albedo = [0.5, 0.6, 0.7]"#;
+
+/// The scene file reads media as the XML front-end does: their
+/// coefficients, the grid placed by its transform, the shapes that bound
+/// them, the camera's; and the scene renders.
+#[test]
+fn scene_files_hold_media() {
+    let dir = scratch_dir("media_toml");
+    let data: Vec<f32> = (0..8).map(|i| i as f32).collect();
+    std::fs::write(
+        dir.join("g.vol"),
+        VolGrid { res: [2, 2, 2], channels: 1, bbox: ([0.0; 3], [1.0; 3]), data }.to_bytes(),
+    )
+    .unwrap();
+    let path = write(&dir, "m.toml", &toml_scene(TOML_MEDIA, "interior = \"smoke\"\nexterior = \"fog\""));
+    let file = photonmap::scene::file::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert!(file.meshes.contains(&dir.join("g.vol")), "the grid is an input of the scene");
+    let scene = Scene::from_parts(file.parts);
+    let media = scene.media().expect("the scene has media");
+    // Media by name: fog then smoke.
+    assert_eq!(media.camera, Some(0));
+    let fog = &media.media[0];
+    assert!(fog.is_homogeneous() && fog.phase == Phase::HenyeyGreenstein { g: 0.3 });
+    assert_eq!(fog.coefficients(Vec3::new(7.0, 0.0, 0.0)).0, Color::new(0.1, 0.2, 0.3));
+    let smoke = &media.media[1];
+    // The corner cell (1, 1, 1) holds 7, centred at (0.5, 0.5, 0.5); scale 2.
+    let (sigma_t, sigma_s) = smoke.coefficients(Vec3::splat(0.5));
+    assert_eq!(sigma_t, Color::splat(14.0));
+    assert!((sigma_s - Color::new(7.0, 8.4, 9.8)).abs().max_element() < 1e-5);
+    // The sphere is primitive 0: smoke inside, fog outside; the wall bounds nothing.
+    assert_eq!(media.after(None, 0, Vec3::Z, -Vec3::Z), Some(1));
+    assert_eq!(media.after(None, 0, Vec3::Z, Vec3::Z), Some(0));
+    assert_eq!(media.after(Some(1), 1, Vec3::Z, Vec3::Z), Some(1));
+    let film = path_traced(&scene, 4);
+    assert!(film.mean() > 0.0);
+}
+
+/// Mistakes in a scene file's media are refused at their place.
+#[test]
+fn scene_file_media_mistakes_are_refused_where_written() {
+    let dir = scratch_dir("media_toml_refusals");
+    let mut bad = VolGrid { res: [1, 1, 1], channels: 1, bbox: ([0.0; 3], [1.0; 3]), data: vec![1.0] }.to_bytes();
+    bad[20] = 2;
+    std::fs::write(dir.join("g.vol"), &bad).unwrap();
+    // (the media, the ball's fields, the text the error is at, what it says)
+    let fog = "[media.fog]\ntype = \"homogeneous\"\n";
+    let cases: Vec<(String, &str, &str, &str)> = vec![
+        (
+            "[media.fog]\ntype = \"gas\"".into(),
+            "",
+            "\"gas\"",
+            "unknown medium type \"gas\" (homogeneous, heterogeneous)",
+        ),
+        (
+            format!("{fog}sigma = [1, 1, 1]"),
+            "",
+            "sigma =",
+            "unknown field `sigma`: it does not apply to type \"homogeneous\"",
+        ),
+        (format!("{fog}albedo = [1.5, 1, 1]"), "", "\"homogeneous\"", "the albedo must lie in [0, 1]"),
+        (format!("{fog}sigma_t = [1, 1, 1]\nsigma_s = [1, 1, 1]"), "", "[1, 1, 1]\nsigma_s", "not both"),
+        (format!("{fog}phase = {{ type = \"hg\", g = 1.0 }}"), "", "1.0 }", "must lie in (-1, 1), got 1"),
+        (format!("{fog}phase = {{ type = \"rayleigh\" }}"), "", "\"rayleigh\"", "unknown phase function \"rayleigh\""),
+        (fog.into(), "interior = \"smog\"", "\"smog\"", "no medium named \"smog\" (defined: fog)"),
+        (
+            format!("{fog}[media.smoke]\ntype = \"heterogeneous\"\nsigma_t = {{ grid = \"g.vol\" }}"),
+            "",
+            "\"g.vol\"",
+            "byte 20: 2 channels (photonmap reads 1 or 3)",
+        ),
+        (
+            format!(
+                "{fog}[media.smoke]\ntype = \"heterogeneous\"\nsigma_t = {{ value = [1, 1, 1], grid = \"g.vol\" }}"
+            ),
+            "",
+            "{ value",
+            "a volume is a constant `value` or a `grid` file",
+        ),
+    ];
+    for (i, (media, ball, at, message)) in cases.iter().enumerate() {
+        let text = toml_scene(media, ball);
+        let offset = text.find(at).unwrap_or_else(|| panic!("case {i}: no {at:?}"));
+        let line = text[..offset].matches('\n').count() + 1;
+        let column = offset - text[..offset].rfind('\n').map_or(0, |n| n + 1) + 1;
+        let path = write(&dir, &format!("r{i}.toml"), &text);
+        let err = match photonmap::scene::file::load(&path) {
+            Ok(_) => panic!("case {i} loads"),
+            Err(e) => e.to_string(),
+        };
+        assert!(err.contains(&format!("r{i}.toml:{line}:{column}:")), "case {i}: not at {line}:{column}: {err}");
+        assert!(err.contains(message), "case {i}: {err}");
+    }
+}

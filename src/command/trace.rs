@@ -36,6 +36,12 @@ pub fn run(cli: Request) -> Result<(), Error> {
     let size = std::fs::metadata(&cli.scene).map_or(String::new(), |m| format!(" ({:.1} MB)", m.len() as f64 / 1e6));
     let wait = Wait::start(Mode::detect(cli.quiet), format!("trace: loading {}{size}", cli.scene.display()));
     let file = crate::scene::file::load(&cli.scene).map_err(|e| Error::Invalid(e.to_string()))?;
+    if !file.parts.media.media.is_empty() {
+        return Err(Error::Invalid(format!(
+            "{}: the scene has participating media, which the Whitted tracer does not render (photonmap does)",
+            cli.scene.display()
+        )));
+    }
     let id =
         SceneId::from_files(&cli.scene, &file.meshes).map_err(|e| Error::Io { path: cli.scene.clone(), source: e })?;
     for input in &id.inputs {

@@ -24,6 +24,7 @@ pub fn build<'i>(src: Source<'i>, def: FileDef<'i>) -> Result<SceneFile, SceneEr
         not_physical: Vec::new(),
         meshes: Vec::new(),
         origins: super::Origins { path: src.path.to_path_buf(), ..Default::default() },
+        media: Default::default(),
     }
     .build(def)
 }
@@ -38,6 +39,7 @@ pub(super) struct Builder<'a> {
     pub(super) not_physical: Vec<SceneError>,
     pub(super) meshes: Vec<std::path::PathBuf>,
     pub(super) origins: super::Origins,
+    pub(super) media: super::medium::MediaDraft,
 }
 
 /// A value with its span and its place in the file, for checks.
@@ -135,10 +137,16 @@ impl<'a> Builder<'a> {
             self.origins.materials.push(place);
             self.names.insert(name, self.materials.len() as u32 - 1);
         }
-        for (i, s) in def.shapes.into_iter().enumerate() {
+        for (name, m) in def.media {
+            self.medium(name, m)?;
+        }
+        for (i, mut s) in def.shapes.into_iter().enumerate() {
             let place = self.place(s.kind.span(), format!("shapes[{i}]"));
             self.origins.objects.push(place);
+            let interface = self.interface(i, &mut s)?;
+            let (prims, lights) = (self.prims.len(), self.lights.len());
             self.shape(i, s)?;
+            self.bind_media(interface, prims, lights);
         }
         for (i, l) in def.lights.into_iter().enumerate() {
             let place = self.place(l.kind.span(), format!("lights[{i}]"));
@@ -147,6 +155,11 @@ impl<'a> Builder<'a> {
         }
         self.origins.camera = self.place(def.camera.span(), "camera".to_string());
         let (camera, rays_per_pixel_edge) = self.camera(&def.camera)?;
+        let camera_medium = match &def.camera.get_ref().medium {
+            Some(m) => Some(self.medium_ref(m, "camera.medium".to_string())?),
+            None => None,
+        };
+        let media = self.media_parts(camera_medium);
         let ambient = match &def.ambient {
             Some(a) => self.color(&at(a, "ambient".into()))?,
             None => Color::ZERO,
@@ -171,7 +184,7 @@ impl<'a> Builder<'a> {
             one_sided: Vec::new(),
             paths: crate::scene::PathLimits::default(),
             texturing: Default::default(),
-            media: Default::default(),
+            media,
         };
         Ok(SceneFile {
             parts,

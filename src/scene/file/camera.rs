@@ -26,6 +26,8 @@ pub struct CameraDef {
     pub rays_per_pixel_edge: Option<Spanned<i64>>,
     pub aperture_radius: Option<Spanned<f32>>,
     pub focus_distance: Option<Spanned<f32>>,
+    /// The participating medium the camera is in (`[media.NAME]`).
+    pub medium: Option<Spanned<String>>,
 }
 
 impl Builder<'_> {

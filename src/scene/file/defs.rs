@@ -27,10 +27,12 @@ pub struct FileDef<'i> {
     pub materials: BTreeMap<String, Entry<'i>>,
     pub shapes: Vec<Entry<'i>>,
     pub lights: Vec<Entry<'i>>,
+    /// Participating media by name, in the order of their names.
+    pub media: BTreeMap<String, Entry<'i>>,
 }
 
 /// The keys of the top level.
-const TOP: [&str; 5] = ["camera", "ambient", "materials", "shapes", "lights"];
+const TOP: [&str; 6] = ["camera", "ambient", "materials", "shapes", "lights", "media"];
 
 impl<'i> FileDef<'i> {
     /// The file's structure, or its first mistake (a syntax error, a key
@@ -39,6 +41,7 @@ impl<'i> FileDef<'i> {
         let root = DeTable::parse(src.text).map_err(|e| src.syntax_error(&e))?;
         let (mut camera, mut ambient) = (None, None);
         let (mut materials, mut shapes, mut lights) = (BTreeMap::new(), Vec::new(), Vec::new());
+        let mut media = BTreeMap::new();
         for (key, value) in root.into_inner() {
             match key.get_ref().as_ref() {
                 "camera" => camera = Some(src.read(value, "camera")?),
@@ -48,6 +51,13 @@ impl<'i> FileDef<'i> {
                         let name = name.into_inner().into_owned();
                         let entry = Entry::new(src, format!("materials.{name}"), table)?;
                         materials.insert(name, entry);
+                    }
+                }
+                "media" => {
+                    for (name, table) in src.table(value, "media")? {
+                        let name = name.into_inner().into_owned();
+                        let entry = Entry::new(src, format!("media.{name}"), table)?;
+                        media.insert(name, entry);
                     }
                 }
                 "shapes" => shapes = src.entries(value, "shapes")?,
@@ -63,7 +73,7 @@ impl<'i> FileDef<'i> {
             }
         }
         let camera = camera.ok_or_else(|| src.error(0..0, "(top level)", "missing field `camera`"))?;
-        Ok(FileDef { camera, ambient, materials, shapes, lights })
+        Ok(FileDef { camera, ambient, materials, shapes, lights, media })
     }
 }
 
@@ -93,6 +103,15 @@ impl<'i> Entry<'i> {
         };
         let kind = Spanned::new(kind_span, name.into_owned());
         Ok(Entry { field, kind, rest: Some(Spanned::new(span, DeValue::Table(table))) })
+    }
+
+    /// Takes key `key` out of the table, before [`Entry::read`] reads the
+    /// rest: a field every type of the section has (a shape's media).
+    pub fn take(&mut self, key: &str) -> Option<Spanned<DeValue<'i>>> {
+        match self.rest.as_mut().map(|r| r.get_mut()) {
+            Some(DeValue::Table(t)) => t.remove(key),
+            _ => None,
+        }
     }
 
     /// Its `type`, for checks (the field `…type`).

@@ -30,6 +30,12 @@ struct GlassDef {
     absorption: Option<Spanned<V3>>,
 }
 
+/// `type = "null"`: nothing there, light passes straight through: the
+/// index-matched boundary of a participating medium (Mitsuba's `null`).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct NullDef {}
+
 /// `type = "phong"`: the CS475 material.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -90,6 +96,10 @@ impl Builder<'_> {
                     mirror: coef(&d.m_r, "m_r", f32::INFINITY)?,
                 }))
             }
+            "null" => {
+                let _: NullDef = entry.read(&self.src)?;
+                Ok(Material::Masked(crate::material::Masked { opacity: 0.0, rho: Color::ZERO }))
+            }
             _ => match self.mitsuba_bsdf(entry)? {
                 Some(m) => Ok(m),
                 None => {
@@ -98,7 +108,7 @@ impl Builder<'_> {
                         kind.span.clone(),
                         &kind.field,
                         format!(
-                            "unknown material type \"{}\" (lambertian, mirror, glass, phong, conductor, \
+                            "unknown material type \"{}\" (lambertian, mirror, glass, phong, null, conductor, \
                              roughconductor, roughdielectric, thindielectric, plastic, roughplastic)",
                             kind.value
                         ),

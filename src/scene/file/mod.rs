@@ -19,6 +19,7 @@ mod defs;
 mod light;
 mod locate;
 mod material;
+mod medium;
 mod mitsuba_bsdf;
 mod read;
 mod shape;
