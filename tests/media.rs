@@ -282,9 +282,9 @@ fn a_medium_that_does_not_absorb_keeps_the_furnace_white() {
         );
         let scene = read(&write(&dir, "f.xml", &furnace_scene(&body))).unwrap();
         assert!(scene.media().is_some());
-        let film = path_traced(&scene, 256);
+        let film = path_traced(&scene, 512);
         let mean = film.pixels.iter().copied().sum::<Color>() / film.pixels.len() as f32;
-        // Uniform: every 4x4 block of pixels (4,096 paths) near 1.
+        // Uniform: every 4x4 block of pixels (8,192 paths) near 1.
         let block = |bx: u32, by: u32| (0..16).map(|i| film.get(4 * bx + i % 4, 4 * by + i / 4)).sum::<Color>() / 16.0;
         let worst = (0..16).map(|b| (block(b % 4, b / 4) - Color::ONE).abs().max_element()).fold(0.0, f32::max);
         println!("{name}: mean {mean}, worst 4x4 block off by {worst}");

@@ -22,6 +22,9 @@
 //!
 //! A path's length is counted as Mitsuba counts it: scattering vertices
 //! (in media and on surfaces), not index-matched crossings.
+//!
+//! The emitted part ([`Part::Emitted`], which the camera pass samples more
+//! at the rims of lights' images) is [`emitted_part`]'s.
 
 use super::mis::power_heuristic;
 use super::path::PathIntegrator;
@@ -59,6 +62,9 @@ struct Scattered {
 
 pub(super) fn radiance(pt: &PathIntegrator, media: &Media, ray: Ray, part: Part, ctx: &mut Context) -> Color {
     let scene = pt.scene;
+    if part == Part::Emitted {
+        return emitted_part(scene, media, ray, ctx);
+    }
     let limits = scene.paths;
     let within = |vertices: u32| limits.max_depth.is_none_or(|m| vertices <= m);
     let mut radiance = Color::ZERO;
@@ -74,16 +80,20 @@ pub(super) fn radiance(pt: &PathIntegrator, media: &Media, ray: Ray, part: Part,
     // weight against `last`.
     let mut count_full = true;
     let mut last: Option<Scattered> = None;
-    let emitted_only = part == Part::Emitted;
     for _ in 0..MAX_EVENTS {
         if !within(vertices + 1) {
             break;
         }
         ctx.counters.rays += 1;
         let med = medium.map(|m| media.get(m));
+        if med.is_some_and(|m| m.scatters()) {
+            // Light seen through a medium that scatters is the reflected
+            // part's (see `emitted_part`).
+            specular_chain = false;
+        }
         // In a homogeneous medium the flight is drawn first, and a surface
         // sought only closer than it (in fog most flights end in it).
-        let drawn = med.filter(|m| !emitted_only && m.is_homogeneous() && m.scatters());
+        let drawn = med.filter(|m| m.is_homogeneous() && m.scatters());
         let distance = drawn.map(|m| m.draw_distance(throughput, ctx.rng));
         let hit = scene.intersect_within(&ray, departure, distance.map_or(f32::INFINITY, |d| d.t));
         let t_surface = hit.as_ref().map_or(f32::INFINITY, |h| h.t);
@@ -93,7 +103,6 @@ pub(super) fn radiance(pt: &PathIntegrator, media: &Media, ray: Ray, part: Part,
                     Flight::Scattered { t: d.t, weight: m.scattered_at(d, ray.at(d.t)) }
                 }
                 (Some(m), Some(d)) => Flight::Passed { weight: m.passed(d, t_surface) },
-                _ if emitted_only => Flight::Passed { weight: med.transmittance(&ray, t_surface, ctx.rng) },
                 _ => med.sample_flight(&ray, t_surface, throughput, ctx.rng),
             };
             match flight {
@@ -128,8 +137,8 @@ pub(super) fn radiance(pt: &PathIntegrator, media: &Media, ray: Ray, part: Part,
         }
         let wanted = match part {
             Part::All => true,
-            Part::Emitted => specular_chain,
             Part::Reflected => !specular_chain,
+            Part::Emitted => unreachable!("the emitted part is emitted_part's"),
         };
         let hidden = vertices == 0 && limits.hide_emitters;
         let Some(hit) = hit else {
@@ -157,13 +166,7 @@ pub(super) fn radiance(pt: &PathIntegrator, media: &Media, ray: Ray, part: Part,
         let (frame, entering) = hit.scattering_frame(ray.dir, &material);
         let n = frame.n;
         let wo = frame.to_local(-ray.dir);
-        let scatter = if emitted_only {
-            let Some(b) = material.specular_branches(wo, entering, Transport::Radiance).choose(ctx.rng) else { break };
-            crate::material::Scatter { wi: b.wi, weight: b.scale, lobe: Lobe::Specular }
-        } else {
-            let Some(s) = material.sample(wo, entering, Transport::Radiance, ctx.rng) else { break };
-            s
-        };
+        let Some(scatter) = material.sample(wo, entering, Transport::Radiance, ctx.rng) else { break };
         if scatter.lobe == Lobe::Specular && scatter.wi == -wo {
             // Straight through an index-matched surface: the same ray
             // goes on, in the medium beyond.
@@ -179,7 +182,7 @@ pub(super) fn radiance(pt: &PathIntegrator, media: &Media, ray: Ray, part: Part,
         // A scattering vertex: its light, then its continuation.
         vertices += 1;
         let smooth = scatter.lobe != Lobe::Specular;
-        if !emitted_only && material.has_smooth_lobes() && within(vertices + 1) {
+        if material.has_smooth_lobes() && within(vertices + 1) {
             let direct = surface_light(scene, media, &hit, &material, &frame, wo, entering, medium, ctx);
             radiance += throughput * ctx.checked(direct, "volpath surface light");
         }
@@ -201,6 +204,61 @@ pub(super) fn radiance(pt: &PathIntegrator, media: &Media, ray: Ray, part: Part,
         let (next, dep) = hit.spawn(dir);
         (ray, departure) = (next, Some(dep));
         if !roulette(&mut throughput, vertices, ctx) {
+            break;
+        }
+    }
+    radiance
+}
+
+/// The emitted part ([`Part::Emitted`]): light reached from the eye along
+/// specular chains (mirrors, glass, index-matched crossings) through vacuum
+/// or media that only absorb, carrying their exact transmittance. Light
+/// seen through a medium that scatters is the reflected part's: its image
+/// there is a glow, which the extra samples the camera pass gives the
+/// emitted part at the rims of lights' images would not sharpen.
+fn emitted_part(scene: &Scene, media: &Media, mut ray: Ray, ctx: &mut Context) -> Color {
+    let limits = scene.paths;
+    let within = |vertices: u32| limits.max_depth.is_none_or(|m| vertices <= m);
+    let (mut departure, mut medium) = (None, media.camera);
+    let (mut throughput, mut vertices, mut radiance) = (Color::ONE, 0u32, Color::ZERO);
+    for _ in 0..MAX_EVENTS {
+        let med = medium.map(|m| media.get(m));
+        if !within(vertices + 1) || med.is_some_and(|m| m.scatters()) {
+            break;
+        }
+        ctx.counters.rays += 1;
+        let hit = scene.intersect(&ray, departure);
+        if let Some(m) = med {
+            throughput *= m.transmittance(&ray, hit.as_ref().map_or(f32::INFINITY, |h| h.t), ctx.rng);
+        }
+        let hidden = vertices == 0 && limits.hide_emitters;
+        let Some(hit) = hit else {
+            if !hidden {
+                radiance += throughput * scene.background(ray.dir);
+            }
+            break;
+        };
+        if !hidden {
+            radiance += throughput * scene.emitted(&hit, ray.dir);
+        }
+        let material = scene.material_seen(&hit, ray.dir);
+        if material.is_emitter() {
+            break;
+        }
+        let (frame, entering) = hit.scattering_frame(ray.dir, &material);
+        let wo = frame.to_local(-ray.dir);
+        let Some(b) = material.specular_branches(wo, entering, Transport::Radiance).choose(ctx.rng) else { break };
+        let straight = b.wi == -wo;
+        let dir = if straight { ray.dir } else { frame.to_world(b.wi).normalize() };
+        if !straight && hit.shading_normal != hit.normal && !hit.leaves_as(ray.dir, dir, b.wi.z > 0.0) {
+            break;
+        }
+        throughput *= b.scale;
+        vertices += (!straight) as u32;
+        medium = media.after(medium, hit.prim, hit.normal, dir);
+        let (next, dep) = hit.spawn(dir);
+        (ray, departure) = (next, Some(dep));
+        if max_component(throughput) <= 0.0 {
             break;
         }
     }
@@ -399,7 +457,8 @@ fn emitted_weight(scene: &Scene, last: &Scattered, hit: &Hit) -> f32 {
 #[inline(never)]
 fn from_infinity(scene: &Scene, last: &Scattered, dir: Vec3) -> Color {
     let mut sum = Color::ZERO;
-    for (index, light) in scene.lights.iter().enumerate() {
+    for &index in scene.lights_at_infinity() {
+        let (index, light) = (index as usize, &scene.lights[index as usize]);
         let le = light.radiance_from_infinity(dir);
         if le != Color::ZERO {
             let pdf = scene.light_prob(index) * light_pdf(light, last, dir, None);

@@ -525,6 +525,12 @@ impl Scene {
         self.media.as_deref()
     }
 
+    /// The indices of the lights at infinity (light from everywhere).
+    #[inline]
+    pub fn lights_at_infinity(&self) -> &[u32] {
+        &self.at_infinity
+    }
+
     /// Radiance arriving along a ray travelling along `dir` that leaves the
     /// scene (light from everywhere; black without it).
     #[inline]
