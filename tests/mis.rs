@@ -266,6 +266,28 @@ fn photon_mapping_with_mis_agrees_in_the_mean() {
     }
 }
 
+/// Where paths are not depth-limited, a glossy camera vertex sends as many
+/// gather rays from its lobe as final gathering sends from a diffuse point
+/// (each weighed 1/n, and MIS weighing n samples of the lobe against the
+/// shadow rays): with 4 gather rays and MIS it agrees in the mean with one
+/// gather ray and shadow rays alone (the same photon maps for both).
+#[test]
+fn glossy_gather_rays_agree_in_the_mean() {
+    for (name, scene) in scenes().into_iter().take(2) {
+        let settings = Settings { photons: 40_000, caustic_photons: 40_000, gather_rays: 4, ..Settings::default() };
+        let est = Estimates::progressive(&scene, &settings, 0);
+        let maps = photon_pass(&scene, &settings, 0, est, Mode::Quiet, &mut Stats::default());
+        let mut integrator = photon_integrator(&scene, &settings, &maps, est);
+        integrator.settings.shadow_rays = shadow_rays(true);
+        let many = blocks(&integrator, &scene, 16, 400, 31);
+        integrator.settings.mis = false;
+        integrator.settings.shadow_rays = shadow_rays(false);
+        integrator.settings.gather_rays = 1;
+        let one = blocks(&integrator, &scene, 16, 400, 32);
+        assert_agree(&format!("{name}, 4 gather rays with MIS against 1 without"), &many, &one);
+    }
+}
+
 /// With as many shadow rays, MIS is far less noisy on the open scene,
 /// whose highlights of the sky and the small light are what it is for
 /// (measured: the path tracer's variance x 0.4, photon mapping's, where

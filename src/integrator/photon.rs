@@ -246,8 +246,9 @@ impl<'a> PhotonIntegrator<'a> {
 
     /// Light reflected by a surface's smooth lobes: its diffuse lobe by
     /// direct light, the caustic map and final gathering; its glossy lobe
-    /// by direct light and one gather ray (through the surface, for rough
-    /// glass).
+    /// by direct light and gather rays sampled from it (through the
+    /// surface, for rough glass): as many as final gathering sends, one
+    /// where paths are depth-limited.
     #[allow(clippy::too_many_arguments)]
     fn surface(
         &self,
@@ -263,15 +264,22 @@ impl<'a> PhotonIntegrator<'a> {
         let s = &self.settings;
         let both = material.transmits();
         // The glossy lobe's share of direct light is also found by its
-        // gather ray (MIS); the diffuse lobe's by shadow rays alone.
+        // gather rays (MIS); the diffuse lobe's by shadow rays alone.
         let mis = material.glossy().filter(|_| s.mis);
+        // As many gather rays from the glossy lobe as final gathering sends
+        // from a diffuse point (one where paths end after it): light that
+        // only paths through glossy lobes find (a light seen through
+        // frosted glass, or in a rough metal through glass) is no less
+        // noisy than a diffuse point's indirect light.
+        let glossy_rays = if self.scene.paths.max_depth.is_some() { 1 } else { s.gather_rays.max(1) };
+        let rays = glossy_rays as f32;
         let direct = match mis {
             Some(g) => {
                 let bsdf = |w: glam::Vec3| {
                     let wi = frame.to_local(w);
                     let shared = g.eval(wo, wi, entering, Transport::Radiance);
                     let alone = (material.eval(wo, wi, entering, Transport::Radiance) - shared).max(Color::ZERO);
-                    MisBsdf { alone, shared, pdf: g.pdf(wo, wi, entering) }
+                    MisBsdf { alone, shared, pdf: rays * g.pdf(wo, wi, entering) }
                 };
                 direct_light_mis(self.scene, hit, n, bsdf, s.shadow_rays, s.skip, both, sh.ctx)
             }
@@ -298,13 +306,16 @@ impl<'a> PhotonIntegrator<'a> {
             indirect = self.indirect(hit, n, rho, w, sh);
         }
         if let Some(g) = material.glossy() {
-            // One gather ray from the glossy lobe: indirect light it
-            // reflects, and with MIS the direct light it meets.
-            if let Some((wi, weight)) = g.sample(wo, entering, Transport::Radiance, sh.ctx.rng) {
+            // Gather rays from the glossy lobe: indirect light it reflects,
+            // and with MIS the direct light they meet (each weighed as one
+            // of `rays` samples).
+            for _ in 0..glossy_rays {
+                let Some((wi, weight)) = g.sample(wo, entering, Transport::Radiance, sh.ctx.rng) else { continue };
                 let dir = frame.to_world(wi).normalize();
                 if hit.leaves_as(-frame.n, dir, wi.z > 0.0) {
                     let (next, dep) = hit.spawn(dir);
-                    let sample = mis.map(|g| self.bsdf_sample(hit, n, g.pdf(wo, wi, entering)));
+                    let sample = mis.map(|g| self.bsdf_sample(hit, n, rays * g.pdf(wo, wi, entering)));
+                    let weight = weight / rays;
                     indirect += weight * self.gather(next, dep, Lobe::Glossy, sample, w * weight, sh);
                 }
             }
