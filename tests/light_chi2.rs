@@ -665,3 +665,89 @@ fn caustic_photons_carry_what_the_light_sends_towards_the_targets() {
     }
     assert!(failed.is_empty(), "{failed:?}");
 }
+
+/// The light hierarchy's choices against its own chances, at three
+/// points among 50 disk lights and 20 triangles of random place, size,
+/// facing and radiance, three point lights and a sky: which light it
+/// chooses (the chance of none too: a descent can end at a light that
+/// sends nothing there), and the direction of the shadow ray that light
+/// then samples, against the density multiple importance sampling weighs
+/// it by, Σ over lights of the chance times the light's own density.
+#[test]
+fn the_light_hierarchy_chooses_lights_by_its_own_chances() {
+    use photonmap::light::LightSampler;
+    let mut rng = stream(91, Domain::Camera, 0);
+    let mut lights = Vec::new();
+    for i in 0..70 {
+        let (u, v) = (next_2d(&mut rng), next_2d(&mut rng));
+        let center = Vec3::new(u.x * 8.0 - 4.0, u.y * 8.0 - 4.0, 1.0 + 3.0 * v.x);
+        let normal = uniform_cone(next_2d(&mut rng), -1.0).normalize();
+        let radiance = Color::new(1.0 + v.y * 4.0, 1.0, 2.0);
+        let surface = if i < 50 {
+            Emitting::Disk(Disk { center, normal, radius: 0.05 + 0.3 * v.y })
+        } else {
+            let f = Frame::from_normal(normal);
+            let s = 0.1 + 0.4 * v.y;
+            Emitting::Triangle(Triangle::new(center, center + f.s * s, center + f.t * s))
+        };
+        lights.push(Light::Area(AreaLight::new(surface, radiance, i)));
+    }
+    for k in 0..3 {
+        let position = Vec3::new(k as f32 * 2.0 - 2.0, 1.0, 2.5);
+        lights.push(Light::Point(PointLight {
+            position,
+            intensity: Color::splat(3.0),
+            falloff: 2.0,
+            dead_distance: 0.0,
+        }));
+    }
+    let mut sky = Light::Constant(Constant::new(Color::splat(0.2)));
+    sky.place(Vec3::splat(-5.0), Vec3::splat(5.0));
+    lights.push(sky);
+    let tree = LightSampler::new(&lights, 10.0);
+    let points = [
+        (Vec3::new(0.0, 0.0, 0.0), Vec3::Z),
+        (Vec3::new(1.5, -2.0, 2.0), Vec3::new(0.3, 0.2, 1.0).normalize()),
+        (Vec3::new(-3.0, 2.5, 3.5), Vec3::new(-1.0, 0.0, 0.2).normalize()),
+    ];
+    let tests = 2 * points.len();
+    let mut failed = Vec::new();
+    for (j, (p, n)) in points.into_iter().enumerate() {
+        let chi2 = Chi2 { samples: 300_000, cos_bins: 16, phi_bins: 32, tests, ..Chi2::default() };
+        let mut rng = stream(92, Domain::Camera, j as u64);
+        let mut observed = vec![0f64; lights.len() + 1];
+        for _ in 0..chi2.samples {
+            match tree.sample(p, n, rand::RngExt::random::<f64>(&mut rng)) {
+                Some((i, _)) => observed[i] += 1.0,
+                None => observed[lights.len()] += 1.0,
+            }
+        }
+        let chances: Vec<f64> = (0..lights.len()).map(|i| tree.pmf(p, n, i) as f64).collect();
+        let total: f64 = chances.iter().sum();
+        assert!(total <= 1.0 + 1e-4 && total > 0.3, "{p}: chances sum to {total}");
+        let mut expected: Vec<f64> = chances.iter().map(|c| c * chi2.samples as f64).collect();
+        expected.push((1.0 - total).max(0.0) * chi2.samples as f64);
+        let o = chi2.pearson(&observed, &expected, total);
+        report("light hierarchy", &format!("lights chosen at {p:.2}"), &o, &mut failed);
+        // The shadow rays' directions, delta lights aside (no density).
+        let o = chi2.run(
+            || {
+                let (i, _) = tree.sample(p, n, rand::RngExt::random::<f64>(&mut rng))?;
+                if lights[i].is_delta() {
+                    return None;
+                }
+                lights[i].sample_li(p, n, next_2d(&mut rng)).map(|inc| inc.dir)
+            },
+            |w| {
+                let w = w.normalize();
+                lights
+                    .iter()
+                    .zip(&chances)
+                    .map(|(l, &c)| if c > 0.0 { c * l.pdf_li(p, n, w) as f64 } else { 0.0 })
+                    .sum()
+            },
+        );
+        report("light hierarchy", &format!("shadow-ray directions at {p:.2}"), &o, &mut failed);
+    }
+    assert!(failed.is_empty(), "{failed:?}");
+}

@@ -70,6 +70,34 @@ fn rough_room(paths: PathLimits) -> Scene {
     Scene::from_parts(parts)
 }
 
+/// The rough room lit by 200 small disks under its ceiling instead of its
+/// one (as many lights are drawn from the light hierarchy, whose chances
+/// the MIS weights must use), of unequal radiance and some tilted.
+fn rough_room_of_many_lights() -> Scene {
+    let mut parts = Scene::tncg15_parts(Eye::One);
+    parts.lights.clear();
+    let rough = rough_room(PathLimits::default());
+    parts.materials = rough.materials[..parts.materials.len() + 1].to_vec();
+    for i in 0..200 {
+        let (x, y) = (1.0 + 9.0 * ((i % 20) as f32 + 0.5) / 20.0, -5.0 + 10.0 * ((i / 20) as f32 + 0.5) / 10.0);
+        let normal = Vec3::new(0.3 * ((i % 3) as f32 - 1.0), 0.2 * ((i % 5) as f32 - 2.0), -1.0).normalize();
+        let disk = Disk { center: Vec3::new(x, y, 4.9), normal, radius: 0.08 };
+        let radiance = Color::splat(40.0 + 20.0 * (i % 4) as f32);
+        parts.lights.push(AreaLight::unplaced(Emitting::Disk(disk), radiance, None));
+    }
+    let floor = parts.materials.len() as u32 - 1;
+    for p in parts.prims.iter_mut() {
+        if let Shape::Triangle(t) = p.shape {
+            if t.normal.z > 0.99 && t.v0.z == -5.0 {
+                p.material = floor;
+            }
+        }
+    }
+    let scene = Scene::from_parts(parts);
+    assert!(scene.many_lights());
+    scene
+}
+
 /// An environment map with a bright patch (a sun) over a dim sky.
 fn sky_map() -> Arc<EnvMap> {
     let (w, h) = (32, 16);
@@ -242,9 +270,10 @@ fn photon_blocks(scene: &Scene, rays: [u32; 2], passes: u32) -> (Blocks, Blocks)
     (mis, plain)
 }
 
-fn scenes() -> [(&'static str, Scene); 3] {
+fn scenes() -> [(&'static str, Scene); 4] {
     [
         ("rough room", rough_room(PathLimits::default())),
+        ("rough room of many lights", rough_room_of_many_lights()),
         ("open scene", open_scene(PathLimits::default())),
         ("open scene, max_depth 2", open_scene(PathLimits { max_depth: Some(2), hide_emitters: false })),
     ]

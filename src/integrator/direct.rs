@@ -39,7 +39,7 @@ pub fn direct_light(
     both_sides: bool,
     ctx: &mut Context,
 ) -> Color {
-    each_light(scene, hit, count, skip, ctx, |light, count, _, ctx| {
+    each_light(scene, hit, n, count, skip, ctx, |light, count, _, ctx| {
         let mut sum = Color::ZERO;
         for s in (0..count).step_by(2) {
             let mut pair = [None; 2];
@@ -92,7 +92,7 @@ pub fn direct_light_mis(
     both_sides: bool,
     ctx: &mut Context,
 ) -> Color {
-    each_light(scene, hit, count, skip, ctx, |light, count, share, ctx| {
+    each_light(scene, hit, n, count, skip, ctx, |light, count, share, ctx| {
         let mut sum = Color::ZERO;
         for s in 0..count {
             let u = stratified_2d(s, count, next_2d(ctx.rng));
@@ -140,7 +140,7 @@ pub fn direct_light_one_at_a_time(
     both_sides: bool,
     ctx: &mut Context,
 ) -> Color {
-    each_light(scene, hit, count, skip, ctx, |light, count, _, ctx| {
+    each_light(scene, hit, n, count, skip, ctx, |light, count, _, ctx| {
         let mut sum = Color::ZERO;
         for s in 0..count {
             let u = stratified_2d(s, count, next_2d(ctx.rng));
@@ -159,11 +159,13 @@ pub fn direct_light_one_at_a_time(
 /// `share` is what the light's own sampling density is multiplied by in
 /// the density of all shadow rays at the point (for MIS,
 /// [`Scene::light_share`]). A scene of many lights
-/// ([`Scene::many_lights`]) draws `count` lights by power instead of
-/// visiting each, one sample each, weighted by the chance of the draw.
+/// ([`Scene::many_lights`]) draws [`crate::light::draws`]`(count)` lights
+/// from the light hierarchy instead of visiting each, one sample each,
+/// weighted by the chance of the draw at the point.
 fn each_light(
     scene: &Scene,
     hit: &Hit,
+    n: Vec3,
     count: u32,
     skip: bool,
     ctx: &mut Context,
@@ -171,9 +173,16 @@ fn each_light(
 ) -> Color {
     let mut sum = Color::ZERO;
     if scene.many_lights() {
-        let draws = count.max(1);
-        for _ in 0..draws {
-            let Some((index, p)) = scene.pick_light_index(ctx.rng.random::<f32>()) else { break };
+        let draws = crate::light::draws(count);
+        for k in 0..draws {
+            // One draw in each of `draws` equal parts of [0, 1): the choices
+            // spread over the lights as their chances say.
+            let u = (k as f64 + ctx.rng.random::<f64>()) / draws as f64;
+            let Some((index, p)) = scene.sample_light(hit.point, n, u) else {
+                // No light sends anything here.
+                ctx.counters.shadow_rays_skipped += 1;
+                continue;
+            };
             let light = &scene.lights[index];
             if skip && light.faces_away(hit.point) {
                 ctx.counters.shadow_rays_skipped += 1;
@@ -217,7 +226,11 @@ fn reaches(hit: &Hit, n: Vec3, dir: Vec3, above: bool) -> bool {
 fn unshadowed(scene: &Scene, hit: &Hit, inc: &Incident, ctx: &mut Context) -> bool {
     let (shadow, dep) = hit.spawn(inc.dir);
     ctx.counters.rays += 1;
-    let t_max = inc.target.map_or(f32::INFINITY, |p| (p - shadow.origin).length());
+    // The ray stops 1e-4 of its length short of the light: a surface
+    // touching the light's own (a neighbour in an emissive mesh, whose
+    // boxes every shadow ray to the mesh would otherwise open) is not
+    // taken for a blocker.
+    let t_max = inc.target.map_or(f32::INFINITY, |p| (p - shadow.origin).length() * (1.0 - 1e-4));
     !scene.occluded(&shadow, Some(dep), t_max, inc.prim)
 }
 
@@ -234,7 +247,7 @@ mod tests {
     /// default room with 100 small triangle lights of unequal radiance
     /// under its ceiling, at points of its floor.
     #[test]
-    fn drawing_many_lights_by_power_keeps_the_mean() {
+    fn drawing_many_lights_from_the_hierarchy_keeps_the_mean() {
         use crate::light::{AreaLight, Emitting};
         use crate::scene::Scene;
         use crate::shape::Triangle;
@@ -265,10 +278,12 @@ mod tests {
             }
             let mean = sum / runs as f64;
             let se = ((sum2 / runs as f64 - mean * mean) / runs as f64).sqrt();
-            // Each light visited: 2,000 samples of each.
+            // Each light visited: 20,000 stratified samples of each (at
+            // 2,000 the disk light's penumbra under the triangles alone
+            // was off by 0.5%).
             let mut want = 0.0f64;
             for light in &scene.lights {
-                let m = 2000;
+                let m = 20_000;
                 let mut acc = 0.0f64;
                 for s in 0..m {
                     let u = stratified_2d(s, m, next_2d(ctx.rng));

@@ -58,7 +58,7 @@ impl BsdfSample {
     /// sample, whose own sampling density towards it is `pdf_light`.
     #[inline]
     fn weight(&self, scene: &Scene, index: usize, pdf_light: f32) -> f32 {
-        power_heuristic(1.0, self.pdf, scene.light_share(index, self.shadow_rays), pdf_light)
+        power_heuristic(1.0, self.pdf, scene.light_share(index, self.shadow_rays, self.point, self.normal), pdf_light)
     }
 
     /// Radiance leaving the area light whose surface the sample met at
@@ -80,7 +80,9 @@ impl BsdfSample {
     #[inline(never)]
     pub fn from_infinity(&self, scene: &Scene, dir: Vec3) -> Color {
         let mut sum = Color::ZERO;
-        for (index, light) in scene.lights.iter().enumerate() {
+        for &index in scene.lights_at_infinity() {
+            let index = index as usize;
+            let light = &scene.lights[index];
             let le = light.radiance_from_infinity(dir);
             if le != Color::ZERO {
                 sum += le * self.weight(scene, index, light.pdf_li(self.point, self.normal, dir));

@@ -2,7 +2,7 @@
 //! radiance or of an image's over a triangle (Mitsuba's area emitter with
 //! a radiance texture). Its surface is a primitive of the scene too.
 
-use super::{aimed_from, Aim, Aimed, Emitted, Incident, Light, Source};
+use super::{aimed_from, Aim, Aimed, Emitted, Incident, Light, LightBounds, Source};
 use crate::math::{Color, Frame, Ray, Vertex};
 use crate::sampling::{concentric_disk, cosine_hemisphere, next_2d, uniform_triangle, Rng};
 use crate::shape::{Departure, Disk, RayShear, Shape, Triangle};
@@ -315,6 +315,13 @@ impl Source for AreaLight {
 
     fn bounds(&self) -> Option<(Vec3, Vec3)> {
         Some(self.surface.shape().bounds())
+    }
+
+    /// Its normal, light leaving up to π/2 from it.
+    fn light_bounds(&self) -> Option<LightBounds> {
+        let (lo, hi) = self.surface.shape().bounds();
+        let phi = self.power().max_element();
+        Some(LightBounds { lo, hi, phi, w: self.surface.normal(), cos_o: 1.0, cos_e: 0.0 })
     }
 
     fn moved(&mut self, origin: Vec3, scale: f32) {

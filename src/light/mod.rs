@@ -26,6 +26,7 @@ mod environment;
 pub mod infinity;
 mod point;
 mod projector;
+mod sampler;
 mod sky;
 mod spot;
 
@@ -34,6 +35,7 @@ pub use directional::Directional;
 pub use environment::Environment;
 pub use point::PointLight;
 pub use projector::Projector;
+pub use sampler::{draws, LightBounds, LightSampler};
 pub use sky::Constant;
 pub use spot::Spot;
 
@@ -154,6 +156,12 @@ pub trait Source {
     /// The box the light occupies, which the scene's bounds hold (`None`:
     /// light from infinity).
     fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        None
+    }
+
+    /// What bounds where and how much it emits, for the light hierarchy
+    /// ([`LightSampler`]); `None`: light from infinity.
+    fn light_bounds(&self) -> Option<LightBounds> {
         None
     }
 
@@ -295,6 +303,11 @@ impl Light {
     /// See [`Source::bounds`].
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         each!(self, l => l.bounds())
+    }
+
+    /// See [`Source::light_bounds`].
+    pub fn light_bounds(&self) -> Option<LightBounds> {
+        each!(self, l => l.light_bounds())
     }
 
     /// See [`Source::place`].

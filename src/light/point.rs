@@ -1,7 +1,7 @@
 //! A point light: `intensity` (W/sr) equally in every direction; the
 //! Whitted course dims it as 1 / (d + dead_distance)^falloff (physical: 2, 0).
 
-use super::{aimed_from, Aim, Aimed, Emitted, Incident, MitsubaEmitter, MitsubaParam, Source};
+use super::{aimed_from, Aim, Aimed, Emitted, Incident, LightBounds, MitsubaEmitter, MitsubaParam, Source};
 use crate::math::{Color, Ray, Vertex};
 use crate::sampling::{uniform_cone, Rng};
 use glam::{Vec2, Vec3};
@@ -53,6 +53,12 @@ impl Source for PointLight {
 
     fn bounds(&self) -> Option<(Vec3, Vec3)> {
         Some((self.position, self.position))
+    }
+
+    /// Every direction.
+    fn light_bounds(&self) -> Option<LightBounds> {
+        let (p, phi) = (self.position, self.power().max_element());
+        Some(LightBounds { lo: p, hi: p, phi, w: Vec3::Z, cos_o: -1.0, cos_e: 0.0 })
     }
 
     fn moved(&mut self, origin: Vec3, scale: f32) {

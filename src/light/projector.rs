@@ -5,7 +5,7 @@
 //! distance facing it receives the same light wherever the frustum reaches
 //! it.
 
-use super::{aimed_from, Aim, Aimed, Emitted, Incident, Source};
+use super::{aimed_from, Aim, Aimed, Emitted, Incident, LightBounds, Source};
 use crate::math::{Color, Ray, Vertex};
 use crate::sampling::Rng;
 use crate::texture::{SurfacePoint, Texture};
@@ -131,6 +131,13 @@ impl Source for Projector {
 
     fn bounds(&self) -> Option<(Vec3, Vec3)> {
         Some((self.position, self.position))
+    }
+
+    /// The cone through the frustum's corners.
+    fn light_bounds(&self) -> Option<LightBounds> {
+        let (p, phi) = (self.position, self.power().max_element());
+        let cos_o = 1.0 / (1.0 + self.tan_x * self.tan_x + self.tan_y * self.tan_y).sqrt();
+        Some(LightBounds { lo: p, hi: p, phi, w: self.axes[2], cos_o, cos_e: 1.0 })
     }
 
     fn moved(&mut self, origin: Vec3, scale: f32) {

@@ -1,7 +1,7 @@
 //! A spot light (Mitsuba's `spot`): a point emitting `intensity` (W/sr)
 //! into a cone, optionally through an image.
 
-use super::{aimed_from, Aim, Aimed, Emitted, Incident, MitsubaEmitter, MitsubaParam, Source};
+use super::{aimed_from, Aim, Aimed, Emitted, Incident, LightBounds, MitsubaEmitter, MitsubaParam, Source};
 use crate::math::{Color, Frame, Ray, Vertex};
 use crate::sampling::{uniform_cone, uniform_cone_pdf, Rng};
 use crate::texture::{SurfacePoint, Texture};
@@ -183,6 +183,13 @@ impl Source for Spot {
 
     fn bounds(&self) -> Option<(Vec3, Vec3)> {
         Some((self.position, self.position))
+    }
+
+    /// Full out to the beam, then falling to the cutoff.
+    fn light_bounds(&self) -> Option<LightBounds> {
+        let (p, phi) = (self.position, self.power().max_element());
+        let cos_e = (self.cutoff - self.cos_beam.clamp(-1.0, 1.0).acos()).max(0.0).cos();
+        Some(LightBounds { lo: p, hi: p, phi, w: self.frame.n, cos_o: self.cos_beam, cos_e })
     }
 
     fn moved(&mut self, origin: Vec3, scale: f32) {

@@ -186,6 +186,8 @@ pub struct Scene {
     targets: Vec<Target>,
     /// The lights by power (largest channel): the photon passes' choice.
     light_pick: Option<Discrete>,
+    /// With many lights, the hierarchy shadow rays choose them by.
+    light_tree: Option<Box<crate::light::LightSampler>>,
     /// Per material, the material seen from behind its geometric normal
     /// (itself where two-sided); empty where every material is.
     back_material: Vec<u32>,
@@ -278,8 +280,8 @@ impl Texturing {
 /// Marks a primitive that is not a light's surface.
 const NO_LIGHT: u32 = u32::MAX;
 
-/// More lights than this are drawn by power for direct light, not visited
-/// one by one ([`Scene::many_lights`]).
+/// More lights than this are drawn from the light hierarchy for direct
+/// light, not visited one by one ([`Scene::many_lights`]).
 pub const MANY_LIGHTS: usize = 64;
 
 /// A scene's ingredients, before [`Scene::from_parts`] derives what the
@@ -499,6 +501,8 @@ impl Scene {
         let prim_material = prims.iter().map(|p| p.material).collect();
         let accel = Accel::with_enclosure(prims.into_iter().map(|p| p.shape).collect(), &group);
         let light_pick = Discrete::new(lights.iter().map(|l| max_component(l.power()) as f64));
+        let light_tree = (lights.len() > MANY_LIGHTS)
+            .then(|| Box::new(crate::light::LightSampler::new(&lights, (hi - lo).length())));
         Scene {
             materials,
             lights,
@@ -511,6 +515,7 @@ impl Scene {
             bounds: (lo, hi),
             targets,
             light_pick,
+            light_tree,
             back_material,
             paths,
             at_infinity,
@@ -744,12 +749,21 @@ impl Scene {
         &self.targets
     }
 
-    /// Whether direct light draws lights by power rather than visiting
-    /// each: a scene of more than [`MANY_LIGHTS`] (an emissive mesh is a
-    /// light per triangle), where visiting each would cost their number.
+    /// Whether direct light draws lights from the light hierarchy rather
+    /// than visiting each: a scene of more than [`MANY_LIGHTS`] (an
+    /// emissive mesh is a light per triangle), where visiting each would
+    /// cost their number.
     #[inline]
     pub fn many_lights(&self) -> bool {
-        self.lights.len() > MANY_LIGHTS
+        self.light_tree.is_some()
+    }
+
+    /// With many lights, a light for a shadow ray at `p` on a surface
+    /// facing `n` chosen from the hierarchy by `u` in [0, 1), and the chance
+    /// of that choice; `None` where no light sends anything there.
+    #[inline]
+    pub fn sample_light(&self, p: Vec3, n: Vec3, u: f64) -> Option<(usize, f32)> {
+        self.light_tree.as_ref()?.sample(p, n, u)
     }
 
     /// The index of a light chosen by `u` in [0, 1) in proportion to its
@@ -769,13 +783,14 @@ impl Scene {
     }
 
     /// What light `index`'s own sampling density is multiplied by in the
-    /// density of the shadow rays at a point that takes `count` of them
-    /// per light: `count` (1 for a delta light), or with many lights the
-    /// chance that any of the `count` draws picks it.
+    /// density of the shadow rays at `p` (facing `n`) that takes `count`
+    /// of them per light: `count` (1 for a delta light), or with many
+    /// lights the draws ([`crate::light::draws`]) times the chance that a
+    /// draw at `p` picks it.
     #[inline]
-    pub fn light_share(&self, index: usize, count: u32) -> f32 {
-        if self.many_lights() {
-            return count.max(1) as f32 * self.light_pick.as_ref().map_or(0.0, |l| l.prob(index));
+    pub fn light_share(&self, index: usize, count: u32, p: Vec3, n: Vec3) -> f32 {
+        if let Some(tree) = &self.light_tree {
+            return crate::light::draws(count) as f32 * tree.pmf(p, n, index);
         }
         if self.lights[index].is_delta() {
             1.0
