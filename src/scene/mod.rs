@@ -441,7 +441,7 @@ impl Scene {
         let light_patterns = std::mem::take(&mut texturing.light_patterns);
         let texturing = texturing.is_used().then(|| Box::new(texturing));
         // A one-sided material's back is a black surface of its own.
-        let back_material = if one_sided.iter().any(|&b| b) {
+        let mut back_material = if one_sided.iter().any(|&b| b) {
             let count = materials.len();
             let mut backs = Vec::with_capacity(count);
             for m in 0..count {
@@ -469,6 +469,11 @@ impl Scene {
         let emitter = materials.len() as u32;
         if specs.iter().any(|l| matches!(l, Light::Area(a) if a.material.is_none())) {
             materials.push(Material::Emitter);
+            // Seen from either side the same: every material has its entry
+            // where any is one-sided (the backs themselves included).
+            if !back_material.is_empty() {
+                back_material.extend(back_material.len() as u32..materials.len() as u32);
+            }
         }
         let objects = prims.iter().map(|p| p.object + 1).max().unwrap_or(0);
         for (i, spec) in specs.iter().enumerate() {

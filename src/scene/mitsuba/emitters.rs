@@ -93,10 +93,8 @@ impl Builder<'_> {
                     (Some(d), None) => d,
                     (None, m) => m.unwrap_or(DAffine3::IDENTITY).transform_vector3(DVec3::Z),
                 };
-                let direction = direction
-                    .try_normalize()
-                    .ok_or_else(|| p.fail(p.loc(), "direction", "must not be zero"))?
-                    .as_vec3();
+                let direction =
+                    super::unit(direction).ok_or_else(|| p.fail(p.loc(), "direction", "must not be zero"))?;
                 let irradiance = p.color("irradiance", Use::Emission)?.unwrap_or(Color::ONE);
                 p.finish("direction, to_world, irradiance")?;
                 Light::Directional(Directional::new(direction, irradiance))

@@ -180,6 +180,11 @@ impl Builder<'_> {
                 let specular = self.reflectance(p, "specular_reflectance", 1.0)?;
                 if p.kind == "conductor" {
                     p.finish("material, eta, k, specular_reflectance")?;
+                    // eta 0 + 1i (material 'none', the export's mirror)
+                    // reflects everything at every angle: the mirror.
+                    if let (true, Param::Fixed(reflectance)) = (eta == Color::ZERO && k == Color::ONE, specular) {
+                        return Ok((Material::Mirror { reflectance }, None, true, None));
+                    }
                     (Textured::Conductor { eta, k, specular }, true)
                 } else {
                     let (distribution, alpha_u, alpha_v) = self.microfacet(p, true)?;

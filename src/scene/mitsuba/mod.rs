@@ -202,6 +202,17 @@ pub fn load(path: &Path, options: &Options) -> Result<Imported, SceneError> {
     Ok(Imported { file, spp, substitutions: b.substitutions, inputs: b.inputs, photon_limit })
 }
 
+/// `d` as a unit vector in single precision: as written where that is
+/// unit already (to its last bits), so that a direction photonmap
+/// normalised and exported reads back the same bits; else normalised.
+fn unit(d: glam::DVec3) -> Option<glam::Vec3> {
+    let v = d.as_vec3();
+    if v.is_finite() && (v.length_squared() - 1.0).abs() <= 4.0 * f32::EPSILON {
+        return Some(v);
+    }
+    d.try_normalize().map(|n| n.as_vec3())
+}
+
 fn place(p: &Plugin) -> Place {
     Place { line: p.loc().line, column: p.loc().column, field: format!("{} '{}'", p.el.tag, p.kind) }
 }

@@ -220,11 +220,19 @@ impl Builder<'_> {
             "disk" => {
                 self.frames.push(affine(&to_world.inverse()));
                 uv = Some(SurfaceUv::Disk(self.frames.len() as u32 - 1));
-                // Mitsuba's normal is to_world's image of +z as a normal.
-                let normal = (to_world.matrix3.inverse().transpose() * DVec3::Z).normalize().as_vec3();
-                let normal = if flip { -normal } else { normal };
+                // Mitsuba's normal is to_world's image of +z as a normal:
+                // for a similarity s R, R's z column.
+                let normal = |s: f64| match super::unit(to_world.matrix3.z_axis / s) {
+                    Some(n) if flip => -n,
+                    Some(n) => n,
+                    None => Vec3::Z,
+                };
                 Mesh::Analytic(match similarity(&to_world) {
-                    Some(s) => Shape::Disk(Disk { center: to_world.translation.as_vec3(), normal, radius: s as f32 }),
+                    Some(s) => Shape::Disk(Disk {
+                        center: to_world.translation.as_vec3(),
+                        normal: normal(s),
+                        radius: s as f32,
+                    }),
                     None => {
                         let e = Ellipse::new(&to_world)
                             .ok_or_else(|| p.fail(p.loc(), "to_world", "the transform is singular"))?;
@@ -274,7 +282,7 @@ impl Builder<'_> {
                 }
                 (Some(radiance), Shape::Disk(d)) => {
                     self.origins.lights.push(super::place(p));
-                    self.lights.push(AreaLight::unplaced(Emitting::Disk(d), radiance, Some(material)))
+                    self.lights.push(AreaLight::unplaced(Emitting::Disk(d), radiance, self.reflecting(material)))
                 }
                 (Some(_), _) => {
                     return Err(p.refuse(format!(
@@ -310,7 +318,7 @@ impl Builder<'_> {
             let mut n = mesh
                 .normals
                 .as_ref()
-                .map(|ns| ns[i].map(|n| (normal_map * n.as_dvec3() * sign).normalize_or_zero().as_vec3()));
+                .map(|ns| ns[i].map(|n| super::unit(normal_map * n.as_dvec3() * sign).unwrap_or(Vec3::ZERO)));
             if reverse {
                 v.swap(1, 2);
                 if let Some(n) = &mut n {
@@ -334,7 +342,7 @@ impl Builder<'_> {
                     self.light_patterns.resize(self.lights.len(), None);
                     self.light_patterns.push(Some(std::sync::Arc::new(pattern)));
                 }
-                self.lights.push(AreaLight::unplaced(Emitting::Triangle(t), radiance, Some(material)));
+                self.lights.push(AreaLight::unplaced(Emitting::Triangle(t), radiance, self.reflecting(material)));
                 continue;
             }
             if let Some(n) = n.filter(|n| n.iter().all(|c| c.length_squared() > 0.0)) {
@@ -359,6 +367,17 @@ impl Builder<'_> {
             }
             self.prims.push(Prim { shape: Shape::Triangle(t), material, object });
         }
+    }
+}
+
+impl Builder<'_> {
+    /// An emitter's material, or `None` where it is black (a diffuse BSDF
+    /// of reflectance 0, what the export gives a pure emitter): the pure
+    /// emitter, which absorbs what reaches it without storing photons.
+    fn reflecting(&self, material: u32) -> Option<u32> {
+        let plain = self.textured.get(material as usize).is_none_or(Option::is_none);
+        let black = matches!(self.materials[material as usize], crate::material::Material::Lambertian { rho } if rho == Color::ZERO);
+        (!(plain && black)).then_some(material)
     }
 }
 
