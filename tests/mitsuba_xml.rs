@@ -658,12 +658,22 @@ fn cylinders_survive_the_export() {
 }
 
 /// Every scene of the suite, exported for Mitsuba and read back by the
-/// XML front-end, renders the image its TOML renders. Not to the bit:
-/// the export places the scene with the eye at the origin (moving every
-/// vertex, in single precision), writes colours as decimal text, and
-/// turns the camera into a look-at sensor; so the images agree within
-/// single-precision geometry, per pixel, on the same seed (photon
-/// mapping's noise is the same noise, drawn from the same streams).
+/// XML front-end, renders the image its TOML renders, to the bit, but for
+/// one thing: the camera. The export writes it as Mitsuba's look-at
+/// sensor, a horizontal field of view and an orientation; the reader
+/// rebuilds the image plane from those in double precision, where the
+/// TOML camera built it from its vertical field of view in single
+/// precision: the plane's corners agree to a few units in their last
+/// place, not to the bit, and a ray through a pixel's sample differs as
+/// much (a caustic's photon density or a shadow's border, met by the other
+/// ray, differs by more). So the test asserts: the geometry, materials,
+/// lights and path limits read back are the ones written (materials by
+/// value: the export numbers them anew); the camera's eye is the same and the rays through its image's corners
+/// within 1e-6;
+/// under the TOML's camera the two scenes render the same image to the
+/// bit; under its own camera the read-back scene's mean within 1e-3.
+/// 07-million only where its mesh has been made (it is not committed:
+/// `cargo run --release --example suite_meshes -- --large`).
 #[test]
 fn suite_scenes_survive_the_export_and_the_import() {
     use photonmap::export::mitsuba::{to_mitsuba, Placement};
@@ -672,8 +682,14 @@ fn suite_scenes_survive_the_export_and_the_import() {
     photonmap::scene::procedural::write_suite_meshes(&root.join("scenes/suite/meshes"), false).unwrap();
     let suite = photonmap::suite::load(&root.join("scenes/suite")).unwrap();
     let mut compared = 0;
-    for s in suite.iter().filter(|s| s.name != "07-million") {
-        let file = photonmap::scene::file::load(&s.scene).unwrap_or_else(|e| panic!("{e}"));
+    for s in &suite {
+        let file = match photonmap::scene::file::load(&s.scene) {
+            Err(e) if s.name == "07-million" => {
+                eprintln!("07-million not compared: {e}");
+                continue;
+            }
+            r => r.unwrap_or_else(|e| panic!("{e}")),
+        };
         let exported = to_mitsuba(&file.parts, Some(&file.origins), "meshes", Placement::new(Vec3::ZERO, 1.0).unwrap())
             .unwrap_or_else(|e| panic!("{}: {}", s.name, e.message));
         std::fs::create_dir_all(dir.join("meshes")).unwrap();
@@ -681,7 +697,30 @@ fn suite_scenes_survive_the_export_and_the_import() {
             std::fs::write(dir.join(name), bytes).unwrap();
         }
         let back = read(&write(&dir, &format!("{}.xml", s.name), &exported.xml), &[])
-            .unwrap_or_else(|e| panic!("{}: {e}", s.name));
+            .unwrap_or_else(|e| panic!("{}: {e}", s.name))
+            .file
+            .parts;
+        let (a, mut b) = (file.parts, back);
+        let n = s.name.as_str();
+        assert_eq!(a.prims.len(), b.prims.len(), "{n}");
+        let sided = |parts: &SceneParts, m: u32| parts.one_sided.get(m as usize).copied().unwrap_or(false);
+        for (i, (p, q)) in a.prims.iter().zip(&b.prims).enumerate() {
+            assert!(p.shape == q.shape, "{n}: primitive {i}: {p:?} against {q:?}");
+            let (m, k) = (p.material, q.material);
+            assert_eq!(a.materials[m as usize], b.materials[k as usize], "{n}: primitive {i}'s material");
+            assert_eq!(sided(&a, m), sided(&b, k), "{n}: primitive {i}'s material's sides");
+        }
+        assert_eq!(a.shading_normals, b.shading_normals, "{n}");
+        assert_eq!(format!("{:?}", a.lights), format!("{:?}", b.lights), "{n}");
+        assert_eq!(a.paths, b.paths, "{n}");
+        let ((ua, xa, da), (ub, xb, db)) = (a.camera.plane(), b.camera.plane());
+        assert_eq!(a.camera.eye, b.camera.eye, "{n}");
+        // The planes may lie at other distances: the rays through their
+        // corners are what must agree.
+        let rays = |e: Vec3, u: Vec3, x: Vec3, d: Vec3| [u, u + x, u + d, u + x + d].map(|c| (c - e).normalize());
+        for (u, v) in rays(a.camera.eye, ua, xa, da).into_iter().zip(rays(b.camera.eye, ub, xb, db)) {
+            assert!((u - v).abs().max_element() <= 1e-6, "{n}: a corner's ray {u} against {v}");
+        }
         let settings = |scene: &Scene| Settings {
             method: Method::Photon,
             photons: 20_000,
@@ -691,13 +730,22 @@ fn suite_scenes_survive_the_export_and_the_import() {
             height: 24 * scene.camera.height / scene.camera.width.max(1),
             ..Settings::default()
         };
-        let a = Scene::from_parts(file.parts);
-        let b = Scene::from_parts(back.file.parts);
-        let (fa, fb) = (render_quiet(&a, &settings(&a)), render_quiet(&b, &settings(&b)));
-        assert_eq!((fa.width, fa.height), (fb.width, fb.height), "{}", s.name);
-        let (ma, mb) = (fa.mean(), fb.mean());
-        assert!((ma - mb).abs() <= 0.02 * ma.abs().max(1e-6), "{}: mean {ma} against {mb}", s.name);
+        let own = Scene::from_parts(b.clone());
+        b.camera = a.camera;
+        let (a, b) = (Scene::from_parts(a), Scene::from_parts(b));
+        let (fa, fb, fo) =
+            (render_quiet(&a, &settings(&a)), render_quiet(&b, &settings(&b)), render_quiet(&own, &settings(&own)));
+        assert_eq!((fa.width, fa.height), (fb.width, fb.height), "{n}");
+        let differing = fa
+            .pixels
+            .iter()
+            .zip(&fb.pixels)
+            .filter(|(p, q)| p.to_array().map(f32::to_bits) != q.to_array().map(f32::to_bits))
+            .count();
+        assert_eq!(differing, 0, "{n}: {differing} pixels differ under the same camera");
+        let (ma, mo) = (fa.mean(), fo.mean());
+        assert!((ma - mo).abs() <= 1e-3 * ma.abs().max(1e-6), "{n}: mean {ma} against {mo} under its own camera");
         compared += 1;
     }
-    assert!(compared >= 7, "{compared} scenes compared");
+    assert!(compared >= suite.len() - 1, "{compared} of {} scenes compared", suite.len());
 }
