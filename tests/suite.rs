@@ -109,6 +109,11 @@ fn suite_10_gold_glass() {
     check("10-gold-glass");
 }
 
+#[test]
+fn suite_11_envmap_glass() {
+    check("11-envmap-glass");
+}
+
 /// Every reference the manifest names loads, with its noise, and a
 /// caustic window's own reference has the window's size.
 #[test]

@@ -12,7 +12,8 @@
 # were extended: a second render with other seeds merged with the first's
 # halves, tools/mitsuba_reference.py --add; the frosted glass's and the
 # gold and glass's were rendered with VARIANT=cuda_ad_rgb on an NVIDIA
-# H100: 1048576 and 2097152 spp, their windows 4194304 and 16777216)
+# H100: 1048576 and 2097152 spp, their windows 4194304 and 16777216; the
+# envmap glass's 16384, 4096 extended by 12288 with --add)
 # Needs Mitsuba 3.9.1 in a Python (MITSUBA_PYTHON, default python3) and, for
 # the llvm variant, DRJIT_LIBLLVM_PATH (see tools/mitsuba_reference.py).
 # Hours of CPU: run it by hand, not in CI.
@@ -47,6 +48,7 @@ scenes=(
   "08-hall caustic=96:128,72:128 --origin 20,9.75,1.05 --scale 100"
   "09-frosted-glass caustic=120:142,86:128"
   "10-gold-glass caustic=121:134,134:152"
+  "11-envmap-glass caustic=114:142,70:102"
 )
 for entry in "${scenes[@]}"; do
   read -r name window placement <<<"$entry"
