@@ -75,6 +75,9 @@ pub struct Stats {
     pub camera: Counters,
     /// Pixels on the rim of a light's image, sampled with `edge_spp`.
     pub edge_pixels: usize,
+    /// The emitted part's samples in each of them (`Settings::edge_spp`,
+    /// or fewer where the rims are many).
+    pub edge_spp: u32,
     pub photon_time: Duration,
     /// The map build: the photon maps (the caustic map's Morton sort and
     /// kd-tree, both maps' grids), then the irradiance cache (estimates at
@@ -126,6 +129,7 @@ impl Stats {
         self.spots = o.spots;
         self.map_bytes = o.map_bytes;
         self.edge_pixels = o.edge_pixels;
+        self.edge_spp = o.edge_spp;
         self.r_global = o.r_global;
         self.r_caustic = o.r_caustic;
         self.k_global = o.k_global;

@@ -50,7 +50,7 @@ impl Summary<'_> {
         if s.edge_pixels > 0 {
             out.push(format!(
                 "               {} pixels on a light's rim took {} extra samples",
-                s.edge_pixels, st.edge_spp
+                s.edge_pixels, s.edge_spp
             ));
         }
         let c = &s.camera;

@@ -147,5 +147,6 @@ pub fn shoot<I: Integrator>(
     stats.camera_time = t.elapsed();
     stats.camera = shot.counters;
     stats.edge_pixels = shot.edge_pixels;
+    stats.edge_spp = shot.edge_spp;
     shot.film
 }

@@ -86,10 +86,16 @@ mod tests {
         let (_, second) = pass(1, &mut rims);
         assert_eq!(rims.as_deref(), Some(&found[..]));
         assert_eq!(second.edge_pixels, first.edge_pixels);
-        // Every pixel given as a rim takes the split estimate.
+        // The rims share the pass's other samples (48 x 48 at 1 spp).
+        assert_eq!(second.edge_spp, settings.edge_spp.min((48 * 48 / first.edge_pixels) as u32));
+        // Every pixel given as a rim takes the split estimate: a primary ray
+        // more for its emitted part, one sample, as the rims may take no
+        // more samples than the pass's others.
+        let (_, none) = pass(1, &mut Some(vec![false; 48 * 48]));
         let (_, all) = pass(1, &mut Some(vec![true; 48 * 48]));
-        assert_eq!(all.edge_pixels, 48 * 48);
-        assert!(all.camera.rays > second.camera.rays + 48 * 48 * 100);
+        assert_eq!((none.edge_pixels, all.edge_pixels), (0, 48 * 48));
+        assert_eq!(all.edge_spp, 1);
+        assert!(all.camera.rays >= none.camera.rays + 48 * 48, "{} {}", all.camera.rays, none.camera.rays);
     }
 
     /// Cache reads left for the end of a pixel and resolved together give
