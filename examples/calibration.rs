@@ -12,7 +12,7 @@
 //! measured, log-log, the band of a factor 1.5 drawn); `--replot` only
 //! redraws the plot from the CSV.
 
-use photonmap::render::accumulation::Accumulation;
+use photonmap::film::accumulation::Accumulation;
 use photonmap::render::{render_passes, Budget};
 use photonmap::scene::Scene;
 use photonmap::settings::{Settings, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP};

@@ -44,8 +44,11 @@ pub mod provenance;
 pub mod render;
 pub mod sampling;
 pub mod scene;
-pub mod settings;
 pub mod shape;
 pub mod stats;
 pub mod suite;
 pub mod texture;
+
+/// Every setting that decides a render ([`render::settings`]), at the
+/// crate's top as the programs and tests name it.
+pub use render::settings;

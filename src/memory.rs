@@ -1,7 +1,7 @@
 //! Memory: what a render will need at its peak, and what the system can
 //! give, so that a render that would not fit is refused before it allocates.
 
-use crate::settings::Settings;
+use crate::render::settings::Settings;
 
 impl Settings {
     /// Bytes the render will hold at its peak, from the peak resident size
@@ -34,7 +34,7 @@ pub fn available_memory() -> Option<u64> {
 
 #[cfg(test)]
 mod tests {
-    use crate::settings::Settings;
+    use crate::render::settings::Settings;
 
     /// The peaks measured (see the doc comment), within 5%.
     #[test]

@@ -3,7 +3,7 @@
 //! every EXR's header, and into partial renders' manifests, where it
 //! decides which partials may be added together.
 
-use crate::settings::Settings;
+use crate::render::settings::Settings;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 

@@ -8,8 +8,8 @@
 //! from 16 passes).
 
 use glam::{Vec2, Vec3};
+use photonmap::film::accumulation::Accumulation;
 use photonmap::metrics::Window;
-use photonmap::render::accumulation::Accumulation;
 use photonmap::render::error_estimate::ErrorEstimate;
 
 use photonmap::render::{render_passes, Budget, Stopped};

@@ -10,8 +10,8 @@ use crate::memory::available_memory;
 use crate::metrics::{reduction_factor, Window};
 use crate::output::read_header;
 use crate::provenance::SceneId;
+use crate::render::settings::Settings;
 use crate::scene::Scene;
-use crate::settings::Settings;
 use std::path::Path;
 
 /// The name the built-in room's default view goes by, which a reference

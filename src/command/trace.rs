@@ -9,10 +9,10 @@ use crate::memory::available_memory;
 use crate::output::{check_writable, same_file, write_with, Extras};
 use crate::progress::{Mode, Wait};
 use crate::provenance::SceneId;
+use crate::render::settings::Settings;
 use crate::render::tracers::WhittedTracing;
 use crate::render::{render_with, Method};
 use crate::scene::Scene;
-use crate::settings::Settings;
 use std::path::PathBuf;
 use std::time::Instant;
 

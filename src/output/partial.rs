@@ -2,13 +2,13 @@
 //! EXR, with a manifest that says what they are sums of. Its R, G, B
 //! channels hold the passes' average, so any viewer shows it; channels
 //! `sums.00` to `sums.47` hold the fixed-point sums as 32-bit words
-//! ([`crate::render::accumulation::PixelSums::words`]); the header
+//! ([`crate::film::accumulation::PixelSums::words`]); the header
 //! attribute `photonmap.manifest` holds the manifest as JSON.
 
 use super::exr_file::{read_channels, write_channels, Samples};
 use super::{atomically, check_writable, Format};
 use crate::error::{Error, Result};
-use crate::render::accumulation::{Accumulation, PassSet, PixelSums, WORDS};
+use crate::film::accumulation::{Accumulation, PassSet, PixelSums, WORDS};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -253,7 +253,7 @@ pub fn merge(parts: &[(String, Partial)], allow_gaps: bool) -> Result<Partial> {
 mod tests {
     use super::*;
     use crate::provenance::settings_key;
-    use crate::settings::Settings;
+    use crate::render::settings::Settings;
 
     #[test]
     fn differing_settings_are_named_field_by_field() {

@@ -9,20 +9,20 @@
 //! pass before ([`super::photon_stage::Estimates::progressive`]), so the
 //! average converges to the true image. A pass depends only on its index
 //! (random streams are keyed by pass, the radius schedule is global), and
-//! the passes' sums are exact ([`super::accumulation`]): any set of passes
+//! the passes' sums are exact ([`crate::film::accumulation`]): any set of passes
 //! can be rendered anywhere, in any order, and added into the same image as
 //! one process would make.
 
-use super::accumulation::Accumulation;
 use super::error_estimate::{ErrorEstimate, Prediction};
 use super::method::RenderMethod;
 use super::render_pass;
+use crate::film::accumulation::Accumulation;
 use crate::film::Film;
 use crate::interrupt;
 use crate::metrics::Window;
 use crate::progress::Mode;
+use crate::render::settings::Settings;
 use crate::scene::Scene;
-use crate::settings::Settings;
 use crate::stats::Stats;
 use std::ops::ControlFlow;
 use std::time::{Duration, Instant};

@@ -24,7 +24,7 @@
 //! calibrates against references. Path tracing has no bias: its passes'
 //! spread alone is its error.
 
-use super::accumulation::{Accumulation, PassSet};
+use crate::film::accumulation::{Accumulation, PassSet};
 use crate::film::Film;
 use crate::math::Color;
 use crate::metrics::Window;

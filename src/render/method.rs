@@ -13,8 +13,8 @@ use super::tracers::{PathTracing, WhittedTracing};
 use crate::film::Film;
 use crate::integrator::Integrator;
 use crate::progress::Mode;
+use crate::render::settings::Settings;
 use crate::scene::Scene;
-use crate::settings::Settings;
 use crate::stats::Stats;
 use std::time::Instant;
 

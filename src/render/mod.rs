@@ -4,13 +4,13 @@
 //! render averages passes whose estimates narrow; the driver ([`driver`])
 //! runs either within a budget, reporting each pass to observers.
 
-pub mod accumulation;
 pub mod camera_pass;
 pub mod driver;
 pub mod error_estimate;
 pub mod method;
 pub mod photon_stage;
 mod rims;
+pub mod settings;
 pub mod tracers;
 
 pub use camera_pass::{camera_pass, CameraPass, Placement};
@@ -20,8 +20,8 @@ pub use photon_stage::GLOBAL_GRID_CELL;
 
 use crate::film::Film;
 use crate::progress::Mode;
+use crate::render::settings::Settings;
 use crate::scene::Scene;
-use crate::settings::Settings;
 use crate::stats::Stats;
 
 /// Renders `scene` (its camera at `settings`' resolution) in one pass.

@@ -13,9 +13,9 @@ use crate::photon::map::PhotonMap;
 use crate::photon::spots::{bright_spots, Spot};
 use crate::photon::trace::{trace_pass, Pass};
 use crate::progress::{Mode, Phase};
+use crate::render::settings::{cache_stride, Settings};
 use crate::sampling::{stream, Domain};
 use crate::scene::Scene;
-use crate::settings::{cache_stride, Settings};
 use crate::stats::{Counters, Stats};
 use std::time::{Duration, Instant};
 

@@ -1,5 +1,8 @@
 //! The film: linear radiance per pixel, row 0 at the top; and the course's
-//! ways of turning it into 8-bit values.
+//! ways of turning it into 8-bit values. The exact sums of a progressive
+//! render's passes are films too ([`accumulation`]).
+
+pub mod accumulation;
 
 use crate::math::Color;
 
