@@ -29,6 +29,7 @@ use photonmap::light::{
 };
 use photonmap::material::Material;
 use photonmap::math::{Color, Frame, Ray};
+use photonmap::photon::aims::specular_targets;
 use photonmap::photon::trace::{emit, Pass};
 use photonmap::sampling::{concentric_disk, next_2d, stream, uniform_cone, Domain, Rng};
 use photonmap::scene::{PathLimits, Prim, Scene, SceneParts};
@@ -463,7 +464,7 @@ fn the_global_pass_emits_what_each_light_sends() {
         let mut next = || {
             k += 1;
             let mut rng = stream(51 + i as u64, Domain::GlobalPhotons, k);
-            emit(&scene, Pass::Global, n, &mut rng).1.map(|(ray, _, power)| (ray, sum(power) * n as f64))
+            emit(&scene, &[], Pass::Global, n, &mut rng).1.map(|(ray, _, power)| (ray, sum(power) * n as f64))
         };
         let o = match placed {
             Light::Directional(d) => {
@@ -520,7 +521,7 @@ fn an_emissive_mesh_emits_by_each_triangles_power() {
         || {
             k += 1;
             let mut rng = stream(62, Domain::GlobalPhotons, k);
-            let (ray, departure, power) = emit(&scene, Pass::Global, n, &mut rng).1?;
+            let (ray, departure, power) = emit(&scene, &[], Pass::Global, n, &mut rng).1?;
             let light = (departure?.prim - first_prim) as usize;
             let a = scene.lights[light].area()?;
             assert!((ray.origin - a.surface.anchor()).dot(a.surface.normal()).abs() < 1e-5, "off its triangle");
@@ -616,14 +617,15 @@ fn caustic_photons_carry_what_the_light_sends_towards_the_targets() {
     let mut failed = Vec::new();
     for (i, (name, light)) in aimed.iter().enumerate() {
         let scene = scene(vec![unplaced(light)], &targets);
-        assert_eq!(scene.specular_targets().len(), targets.len());
+        let aims = specular_targets(&scene);
+        assert_eq!(aims.len(), targets.len());
         let placed = &scene.lights[0];
         let n = chi2.samples as u64;
         let mut k = 0;
         let mut next = || {
             k += 1;
             let mut rng = stream(81 + i as u64, Domain::CausticPhotons, k);
-            emit(&scene, Pass::Caustic, n, &mut rng).1.map(|(ray, _, power)| (ray, sum(power) * n as f64))
+            emit(&scene, &aims, Pass::Caustic, n, &mut rng).1.map(|(ray, _, power)| (ray, sum(power) * n as f64))
         };
         let o = match placed {
             Light::Directional(d) => {

@@ -24,6 +24,7 @@ use super::mis::BsdfSample;
 use super::{direct_light, direct_light_mis, Context, Integrator, MisBsdf, Part};
 use crate::material::{Branch, Branches, Glossy, Lobe, Material, Transport};
 use crate::math::{Color, Frame, Ray};
+use crate::photon::aims::Target;
 use crate::photon::irradiance_cache::{CellRange, IrradianceCache};
 use crate::photon::map::{ConeEstimate, PhotonMap, Scratch};
 use crate::photon::spots::Spot;
@@ -137,6 +138,8 @@ pub struct PhotonIntegrator<'a> {
     pub cache: &'a IrradianceCache,
     /// Bright spots final gathering aims at.
     pub spots: &'a [Spot],
+    /// The mirror and glass objects' bounding spheres, which it aims at too.
+    pub targets: &'a [Target],
     pub settings: PhotonEstimator,
 }
 
@@ -435,7 +438,7 @@ impl<'a> PhotonIntegrator<'a> {
     /// unbiased choice, the weights use the pdf of what was sampled; the
     /// map follows a flat spot's light closely).
     fn aims(&self, x: glam::Vec3) -> impl Iterator<Item = Aim<'a>> + 'a {
-        let targets = self.scene.specular_targets().iter().map(|t| Aim::Sphere(t.center, t.radius));
+        let targets = self.targets.iter().map(|t| Aim::Sphere(t.center, t.radius));
         targets.chain(self.spots.iter().filter(move |s| s.faces(x)).map(|s| match &s.patch {
             Some(map) => Aim::Patch(map, s.radius),
             None => Aim::Sphere(s.center, s.radius),

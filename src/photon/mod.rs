@@ -11,6 +11,7 @@
 //!   estimate is unchanged) and stores only the paths light → specular+ →
 //!   diffuse: the caustic map, read directly at visible surfaces.
 
+pub mod aims;
 mod blocks;
 mod facing;
 mod grid;

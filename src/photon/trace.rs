@@ -6,12 +6,13 @@
 //! order, a block's photons interleaved in a fixed schedule, so the maps
 //! are identical whatever the number of threads.
 
+use super::aims::{specular_targets, Target};
 use super::{Photon, PhotonBlocks};
 use crate::light::Aim;
 use crate::material::{Lobe, Transport};
 use crate::math::{max_component, Color, Frame, Ray};
 use crate::sampling::{concentric_disk, next_2d, stream, uniform_cone, uniform_cone_pdf, Domain, Rng};
-use crate::scene::{Scene, Target};
+use crate::scene::Scene;
 use crate::shape::Departure;
 use glam::{Vec2, Vec3};
 use rand::RngExt;
@@ -42,7 +43,7 @@ pub struct PassOutput {
     /// Emitted photons whose first hit was a specular object (caustic pass:
     /// the aiming efficiency).
     pub first_hit_specular: u64,
-    /// Caustic pass: per target ([`Scene::specular_targets`]), the photons
+    /// Caustic pass: per target ([`specular_targets`]), the photons
     /// aimed at it and those of them whose first hit was mirror or glass.
     pub aimed: Vec<[u64; 2]>,
     /// Emitted photons whose first ray met the scene.
@@ -61,10 +62,23 @@ struct Tally {
 /// Traces `n` photons of `pass`; `on_block` is told the number of photons
 /// done after each block (for progress bars).
 pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn Fn(u64) + Sync)) -> PassOutput {
+    trace_pass_with(scene, &specular_targets(scene), pass, n, seed, on_block)
+}
+
+/// [`trace_pass`] with the scene's caustic targets found already
+/// ([`specular_targets`]).
+pub fn trace_pass_with(
+    scene: &Scene,
+    targets: &[Target],
+    pass: Pass,
+    n: u64,
+    seed: u64,
+    on_block: &(dyn Fn(u64) + Sync),
+) -> PassOutput {
     // Lights that emit nothing emit no photons (choosing among them by power
     // would divide zero by zero).
     let emits = max_component(scene.emitted_power()) > 0.0;
-    if n == 0 || !emits || (pass == Pass::Caustic && scene.specular_targets().is_empty()) {
+    if n == 0 || !emits || (pass == Pass::Caustic && targets.is_empty()) {
         return PassOutput { emitted: n, ..PassOutput::default() };
     }
     let domain = match pass {
@@ -92,7 +106,7 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
         // are faulted in only as photons are written.
         .map_init(Vec::new, |out: &mut Vec<Photon>, b| {
             let (start, end) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
-            let tally = trace_range::<LANES>(scene, pass, n, seed, domain, start..end, out);
+            let tally = trace_range::<LANES>(scene, targets, pass, n, seed, domain, start..end, out);
             // Progress in the photons asked for.
             let asked_by = |i: u64| (i as u128 * asked as u128 / n as u128) as u64;
             on_block(asked_by(end) - asked_by(start));
@@ -100,8 +114,7 @@ pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn 
             (std::mem::replace(out, Vec::with_capacity(capacity)), tally)
         })
         .collect();
-    let mut output =
-        PassOutput { emitted: n, aimed: vec![[0; 2]; scene.specular_targets().len()], ..Default::default() };
+    let mut output = PassOutput { emitted: n, aimed: vec![[0; 2]; targets.len()], ..Default::default() };
     let mut blocks = Vec::with_capacity(per_block.len());
     for (photons, tally) in per_block {
         blocks.push(photons);
@@ -139,7 +152,7 @@ fn landing_fraction(scene: &Scene, seed: u64) -> f64 {
         .into_par_iter()
         .filter(|&i| {
             let mut rng = stream(seed, Domain::GlobalPhotons, i);
-            emit(scene, Pass::Global, PILOT, &mut rng)
+            emit(scene, &[], Pass::Global, PILOT, &mut rng)
                 .1
                 .is_some_and(|(ray, dep, _)| scene.intersect(&ray, dep).is_some())
         })
@@ -152,8 +165,15 @@ pub type PhotonStart = (Ray, Option<Departure>, Color);
 
 /// Picks a light in proportion to its power (one light: always it) and
 /// starts photon `rng` of `n` from it; for the caustic pass, also the
-/// target it was aimed at (whether or not the light could send it there).
-pub fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> (Option<usize>, Option<PhotonStart>) {
+/// target of `targets` it was aimed at (whether or not the light could
+/// send it there).
+pub fn emit(
+    scene: &Scene,
+    targets: &[Target],
+    pass: Pass,
+    n: u64,
+    rng: &mut Rng,
+) -> (Option<usize>, Option<PhotonStart>) {
     let Some((light, p_light)) = scene.pick_light(rng.random::<f32>()) else {
         return (None, None);
     };
@@ -168,7 +188,6 @@ pub fn emit(scene: &Scene, pass: Pass, n: u64, rng: &mut Rng) -> (Option<usize>,
             (None, (max_component(power) > 0.0).then_some((e.ray, e.departure, power)))
         }
         Pass::Caustic => {
-            let targets = scene.specular_targets();
             let chosen = ((rng.random::<f32>() * targets.len() as f32) as usize).min(targets.len() - 1);
             // The power is what the light sends along the photon divided by
             // the density of the aiming: the mixture over all targets.
@@ -266,8 +285,10 @@ const LANES: usize = 2;
 /// Returns (rays cast, photons whose first hit was specular). One lane is
 /// the plain loop, one photon after another: any number of lanes stores the
 /// same photons, in another order within the block (tested below).
+#[allow(clippy::too_many_arguments)]
 fn trace_range<const L: usize>(
     scene: &Scene,
+    targets: &[Target],
     pass: Pass,
     n: u64,
     seed: u64,
@@ -276,13 +297,13 @@ fn trace_range<const L: usize>(
     out: &mut Vec<Photon>,
 ) -> Tally {
     let mut next = range.start;
-    let mut tally = Tally { aimed: vec![[0; 2]; scene.specular_targets().len()], ..Default::default() };
+    let mut tally = Tally { aimed: vec![[0; 2]; targets.len()], ..Default::default() };
     // The next photon of the range that leaves its light.
     let start = |next: &mut u64, tally: &mut Tally| -> Option<Path> {
         while *next < range.end {
             let mut rng = stream(seed, domain, *next);
             *next += 1;
-            let (target, emitted) = emit(scene, pass, n, &mut rng);
+            let (target, emitted) = emit(scene, targets, pass, n, &mut rng);
             if let Some(t) = target {
                 tally.aimed[t][0] += 1;
             }
@@ -418,11 +439,12 @@ mod tests {
         let scene = Scene::tncg15(Eye::One);
         for pass in [Pass::Global, Pass::Caustic] {
             let domain = if pass == Pass::Global { Domain::GlobalPhotons } else { Domain::CausticPhotons };
+            let targets = specular_targets(&scene);
             let run = |lanes: usize| {
                 let mut out = Vec::new();
                 let counts = match lanes {
-                    1 => trace_range::<1>(&scene, pass, 8000, 3, domain, 1000..5000, &mut out),
-                    _ => trace_range::<LANES>(&scene, pass, 8000, 3, domain, 1000..5000, &mut out),
+                    1 => trace_range::<1>(&scene, &targets, pass, 8000, 3, domain, 1000..5000, &mut out),
+                    _ => trace_range::<LANES>(&scene, &targets, pass, 8000, 3, domain, 1000..5000, &mut out),
                 };
                 let mut bits: Vec<[u32; 7]> = out
                     .iter()

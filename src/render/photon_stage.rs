@@ -8,10 +8,11 @@ use super::method::{shoot, Method, MethodSummary, RenderMethod};
 use crate::film::Film;
 use crate::integrator::photon::{PhotonEstimator, PhotonIntegrator};
 use crate::integrator::{direct_irradiance, Context};
+use crate::photon::aims::{disk_coverage, needs, specular_targets, Target};
 use crate::photon::irradiance_cache::IrradianceCache;
 use crate::photon::map::PhotonMap;
 use crate::photon::spots::{bright_spots, Spot};
-use crate::photon::trace::{trace_pass, Pass};
+use crate::photon::trace::{trace_pass_with, Pass};
 use crate::progress::{Mode, Phase};
 use crate::render::settings::{cache_stride, Settings};
 use crate::sampling::{stream, Domain};
@@ -165,6 +166,8 @@ pub struct Maps {
     pub caustic: PhotonMap,
     pub cache: IrradianceCache,
     pub spots: Vec<Spot>,
+    /// The scene's caustic targets, which final gathering aims at too.
+    pub targets: Vec<Target>,
 }
 
 /// Traces the photons of pass `pass` and builds its maps.
@@ -177,7 +180,8 @@ pub fn photon_pass(
     stats: &mut Stats,
 ) -> Maps {
     let seed = pass_seed(settings.seed, pass);
-    let needs = scene.needs();
+    let targets = specular_targets(scene);
+    let needs = needs(scene, &targets);
     stats.skipped_global = settings.skip && !needs.global;
     stats.skipped_caustic = settings.skip && !needs.caustics;
     let settings = &Settings {
@@ -190,8 +194,8 @@ pub fn photon_pass(
     // Both passes at once: the threads that finish one pass's last blocks
     // early take the other's instead of waiting.
     let (global, caustic) = rayon::join(
-        || trace_pass(scene, Pass::Global, settings.photons, seed, &|n| phase.advance(n)),
-        || trace_pass(scene, Pass::Caustic, settings.caustic_photons, seed, &|n| phase.advance(n)),
+        || trace_pass_with(scene, &targets, Pass::Global, settings.photons, seed, &|n| phase.advance(n)),
+        || trace_pass_with(scene, &targets, Pass::Caustic, settings.caustic_photons, seed, &|n| phase.advance(n)),
     );
     phase.finish();
     stats.photon_time += t.elapsed();
@@ -199,7 +203,6 @@ pub fn photon_pass(
     stats.global_landed += global.landed;
     stats.caustic_emitted += caustic.emitted;
     stats.caustic_aimed_hits += caustic.first_hit_specular;
-    let targets = scene.specular_targets();
     if stats.caustic_targets.len() < targets.len() {
         stats.caustic_targets = targets.iter().map(|t| (t.object, 0, 0)).collect();
     }
@@ -232,7 +235,7 @@ pub fn photon_pass(
     let stride = settings.cache_stride.unwrap_or_else(|| cache_stride(est.k_global, global_map.len()));
     // Estimates near an edge or a contact are divided by the part of
     // their disk that lies on their surface.
-    let coverage = |x, n, r| scene.disk_coverage(x, n, r, COVERAGE_SAMPLES);
+    let coverage = |x, n, r| disk_coverage(scene, x, n, r, COVERAGE_SAMPLES);
     // The global map holds no photon's first hit: the cache adds the
     // direct light by shadow rays.
     let direct = |i: u64, x, n| {
@@ -253,7 +256,7 @@ pub fn photon_pass(
     stats.caustic_stored = caustic_map.len();
     stats.cache_points = cache.len();
     stats.map_bytes = global_map.memory_bytes() + caustic_map.memory_bytes();
-    Maps { caustic: caustic_map, cache, spots }
+    Maps { caustic: caustic_map, cache, spots, targets }
 }
 
 /// Shadow rays per area light for a cache point's direct irradiance.
@@ -291,6 +294,7 @@ pub fn photon_integrator<'a>(
         caustic: &maps.caustic,
         cache: &maps.cache,
         spots: &maps.spots,
+        targets: &maps.targets,
         settings: PhotonEstimator {
             k_caustic: est.k_caustic,
             r_caustic: est.r_caustic,

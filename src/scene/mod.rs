@@ -138,35 +138,6 @@ impl Hit {
     }
 }
 
-/// The parts of light transport a scene can have (see [`Scene::needs`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Needs {
-    /// Light reaching diffuse surfaces through mirrors or glass.
-    pub caustics: bool,
-    /// Light reflected between diffuse surfaces.
-    pub global: bool,
-}
-
-/// A bounding sphere of an object with a mirror or glass lobe, for aiming
-/// caustic photons: one per object (a mesh of a million triangles is one
-/// target), so that the cost of aiming a photon and the share of photons an
-/// object gets do not grow with its triangles.
-#[derive(Clone, Copy, Debug)]
-pub struct Target {
-    pub center: Vertex,
-    pub radius: f32,
-    /// The object it bounds.
-    pub object: u32,
-}
-
-impl Target {
-    /// The cone from `from` that just contains the target's sphere
-    /// ([`crate::sampling::cone_to_sphere`]).
-    pub fn cone_from(&self, from: Vec3) -> (Vec3, f32) {
-        crate::sampling::cone_to_sphere(from, self.center, self.radius)
-    }
-}
-
 pub struct Scene {
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
@@ -183,7 +154,10 @@ pub struct Scene {
     shading_normals: Vec<[u32; 3]>,
     accel: Accel,
     bounds: (Vec3, Vec3),
-    targets: Vec<Target>,
+    /// Per primitive, its object (a scene file's shape, an emitter's
+    /// surface): what caustic photons aim at is an object
+    /// ([`crate::photon::aims`]).
+    prim_object: Vec<u32>,
     /// The lights by power (largest channel): the photon passes' choice.
     light_pick: Option<Discrete>,
     /// With many lights, the hierarchy shadow rays choose them by.
@@ -342,30 +316,6 @@ impl SceneParts {
     }
 }
 
-/// One bounding sphere per object with a mirror or glass lobe, in the order
-/// of the objects: centred on the object's box, holding every primitive's
-/// own bounding sphere.
-fn specular_targets(prims: &[Prim], materials: &[Material]) -> Vec<Target> {
-    let mut boxes: std::collections::BTreeMap<u32, (Vec3, Vec3)> = Default::default();
-    let specular = |p: &&Prim| materials[p.material as usize].has_specular_lobe();
-    for p in prims.iter().filter(specular) {
-        let (lo, hi) = p.shape.bounds();
-        let b = boxes.entry(p.object).or_insert((lo, hi));
-        *b = (b.0.min(lo), b.1.max(hi));
-    }
-    let mut targets: std::collections::BTreeMap<u32, Target> = boxes
-        .into_iter()
-        .map(|(object, (lo, hi))| (object, Target { center: 0.5 * (lo + hi), radius: 0.0, object }))
-        .collect();
-    for p in prims.iter().filter(specular) {
-        let (c, r) = p.shape.bounding_sphere();
-        if let Some(t) = targets.get_mut(&p.object) {
-            t.radius = t.radius.max(c.distance(t.center) + r);
-        }
-    }
-    targets.into_values().collect()
-}
-
 /// Each blend's summary from its materials' (blends nest: a blend's
 /// materials are summarised first).
 fn blend_summaries(materials: &mut [Material], texturing: &Texturing) {
@@ -499,11 +449,11 @@ impl Scene {
         let at_infinity = (0..lights.len() as u32)
             .filter(|&i| lights[i as usize].bounds().is_none() && !lights[i as usize].is_delta())
             .collect();
-        let targets = specular_targets(&prims, &materials);
         // Lights stay out of the enclosure: their hits must name them.
         let group: Vec<Option<u32>> =
             prims.iter().zip(&prim_light).map(|(p, &l)| (l == NO_LIGHT).then_some(p.material)).collect();
         let prim_material = prims.iter().map(|p| p.material).collect();
+        let prim_object = prims.iter().map(|p| p.object).collect();
         let accel = Accel::with_enclosure(prims.into_iter().map(|p| p.shape).collect(), &group);
         let light_pick = Discrete::new(lights.iter().map(|l| max_component(l.power()) as f64));
         let light_tree = (lights.len() > MANY_LIGHTS)
@@ -518,7 +468,7 @@ impl Scene {
             shading_normals: shading_normals.iter().map(|n| n.map(crate::math::encode_unit)).collect(),
             accel,
             bounds: (lo, hi),
-            targets,
+            prim_object,
             light_pick,
             light_tree,
             back_material,
@@ -595,41 +545,11 @@ impl Scene {
         }
     }
 
-    /// The fraction of the disk of radius `r` around `x`, in the plane of
-    /// unit normal `n` (x's surface, on the side `n` faces), that lies on a
-    /// surface facing like x's: the part of a density estimate's disk that
-    /// can hold its photons. Measured at a fixed pattern of `samples`
-    /// points: each counts where a short ray down from just above it meets
-    /// a surface facing within 25 degrees of `n` within twice that height.
-    /// Beyond an edge nothing is met (or a surface facing elsewhere); under
-    /// an object standing on the surface, its underside is met.
-    pub fn disk_coverage(&self, x: Vertex, n: Vec3, r: f32, samples: u32) -> f32 {
-        if !(r > 0.0) || samples == 0 {
-            return 1.0;
-        }
-        let frame = Frame::from_normal(n);
-        let height = 0.05 * r + 1e-5 * x.abs().max_element();
-        let mut on = 0;
-        for i in 0..samples {
-            // A Fermat spiral: equal areas per sample, no random numbers.
-            let radius = r * ((i as f32 + 0.5) / samples as f32).sqrt();
-            let angle = i as f32 * 2.399_963;
-            let q = x + radius * (angle.cos() * frame.s + angle.sin() * frame.t);
-            let ray = Ray::new(q + height * n, -n);
-            if let Some(h) = self.intersect(&ray, None) {
-                let facing = if h.normal.dot(n) >= 0.0 { h.normal } else { -h.normal };
-                let same_side = h.normal.dot(-n) < 0.0;
-                on += (h.t <= 2.0 * height && same_side && facing.dot(n) >= 0.9) as u32;
-            }
-        }
-        on as f32 / samples as f32
-    }
-
     /// Bytes the scene's geometry holds: the shapes and the accelerator,
     /// the per-primitive material and light, the vertex normals.
     pub fn memory_bytes(&self) -> usize {
         self.accel.memory_bytes()
-            + (self.prim_material.capacity() + self.prim_light.capacity()) * 4
+            + (self.prim_material.capacity() + self.prim_light.capacity() + self.prim_object.capacity()) * 4
             + self.shading_normals.capacity() * std::mem::size_of::<[u32; 3]>()
     }
 
@@ -749,9 +669,9 @@ impl Scene {
         (self.bounds.1 - self.bounds.0).length()
     }
 
-    /// Bounding spheres of the objects with a mirror or glass lobe.
-    pub fn specular_targets(&self) -> &[Target] {
-        &self.targets
+    /// The object primitive `prim` belongs to.
+    pub fn object(&self, prim: u32) -> u32 {
+        self.prim_object[prim as usize]
     }
 
     /// Whether direct light draws lights from the light hierarchy rather
@@ -826,23 +746,6 @@ impl Scene {
     /// Total emitted power per channel.
     pub fn emitted_power(&self) -> Color {
         self.lights.iter().map(|l| l.power()).sum()
-    }
-
-    /// What this scene's light transport can need, so that a render skips
-    /// the rest.
-    pub fn needs(&self) -> Needs {
-        let lit = crate::math::max_component(self.emitted_power()) > 0.0;
-        let diffuse = self.prim_material.iter().any(|&m| self.materials[m as usize].diffuse_rho().is_some());
-        // Paths of at most two vertices (lights seen, direct light) read no map.
-        let lit = lit && self.paths.max_depth.is_none_or(|d| d > 2);
-        Needs {
-            // Caustic paths need a mirror or glass object and a diffuse
-            // surface to land on.
-            caustics: lit && diffuse && !self.targets.is_empty(),
-            // Indirect diffuse light needs light reflected by a diffuse
-            // surface (a black room has none).
-            global: lit && diffuse,
-        }
     }
 }
 
@@ -923,27 +826,6 @@ mod tests {
     /// floor, half of it at a wall's foot, a quarter in a corner of the
     /// room; less where the tetrahedron stands on the floor.
     #[test]
-    fn disk_coverage_is_the_part_of_the_disk_on_the_surface() {
-        let scene = Scene::tncg15(Eye::One);
-        let up = Vec3::Z;
-        let cover = |x: Vec3, n: Vec3| scene.disk_coverage(x, n, 0.5, 256);
-        assert_eq!(cover(Vec3::new(5.0, 0.0, -5.0), up), 1.0);
-        // The wall P1-P2 is y = 6 for x in [0, 10].
-        let foot = cover(Vec3::new(5.0, 6.0, -5.0), up);
-        assert!((foot - 0.5).abs() < 0.03, "{foot}");
-        // The corner P2: walls P1-P2 (y = 6) and P2-P3 meet at (10, 6); the
-        // angle there is 116.6 degrees, so a little under a third of the disk.
-        let corner = cover(Vec3::new(10.0, 6.0, -5.0), up);
-        let want = (180.0 - 63.43) / 360.0;
-        assert!((corner - want).abs() < 0.03, "{corner} vs {want}");
-        // Beside the tetrahedron's base (A, B at x = 10.8): partly under it.
-        let under = cover(Vec3::new(10.9, 0.0, -5.0), up);
-        assert!(under > 0.1 && under < 0.9, "{under}");
-        // On a wall, facing into the room.
-        assert_eq!(cover(Vec3::new(5.0, 6.0, 0.0), -Vec3::Y), 1.0);
-    }
-
-    #[test]
     fn default_scene_is_the_spec() {
         let scene = Scene::tncg15(Eye::One);
         // 24 room triangles + glass + mirror + 4 tetrahedron faces + the light.
@@ -960,6 +842,6 @@ mod tests {
         }
         let (lo, hi) = scene.bounds();
         assert_eq!((lo, hi), (Vec3::new(-3.0, -6.0, -5.0), Vec3::new(13.0, 6.0, 5.0)));
-        assert_eq!(scene.specular_targets().len(), 2);
+        assert_eq!(crate::photon::aims::specular_targets(&scene).len(), 2);
     }
 }
