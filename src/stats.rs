@@ -48,98 +48,151 @@ impl Counters {
     }
 }
 
-/// What a render did and what it cost.
-#[derive(Clone, Debug, Default)]
-pub struct Stats {
-    pub global_emitted: u64,
+/// How a pass's value of a statistic joins a render's: added (`sum`), the
+/// last pass's (`last`: map sizes, radii), or merged ([`Absorb`]).
+macro_rules! join {
+    (sum, $total:expr, $pass:expr) => {
+        $total += $pass
+    };
+    (last, $total:expr, $pass:expr) => {
+        $total = $pass
+    };
+    (merge, $total:expr, $pass:expr) => {
+        Absorb::absorb(&mut $total, $pass)
+    };
+}
+
+/// The render's statistics: each field declared once, with how a pass's
+/// value joins the render's, so that [`Stats::absorb`] cannot miss one.
+macro_rules! stats {
+    ($($(#[$doc:meta])* $name:ident: $ty:ty => $how:ident,)*) => {
+        /// What a render did and what it cost.
+        #[derive(Clone, Debug, Default)]
+        pub struct Stats {
+            $($(#[$doc])* pub $name: $ty,)*
+        }
+
+        impl Stats {
+            /// Adds another pass's counts and times (maps' sizes and radii
+            /// are the last pass's).
+            pub fn absorb(&mut self, pass: Stats) {
+                $(join!($how, self.$name, pass.$name);)*
+            }
+        }
+    };
+}
+
+stats! {
+    global_emitted: u64 => sum,
     /// Global-pass photons whose first ray met the scene (fewer than
     /// emitted where light from outside misses it).
-    pub global_landed: u64,
-    pub global_stored: usize,
-    pub caustic_emitted: u64,
-    pub caustic_stored: usize,
+    global_landed: u64 => sum,
+    global_stored: usize => last,
+    caustic_emitted: u64 => sum,
+    caustic_stored: usize => last,
     /// Caustic-pass photons whose first hit was mirror or glass.
-    pub caustic_aimed_hits: u64,
+    caustic_aimed_hits: u64 => sum,
     /// Per caustic target: its object (the scene file's shape index), the
     /// photons aimed at it, and those whose first hit was mirror or glass.
-    pub caustic_targets: Vec<(u32, u64, u64)>,
+    caustic_targets: Vec<(u32, u64, u64)> => merge,
     /// Global-pass photons whose first hit was mirror or glass (what the
     /// caustic pass would get without aiming).
-    pub global_specular_hits: u64,
-    pub cache_points: usize,
+    global_specular_hits: u64 => sum,
+    cache_points: usize => last,
+    /// Shadow rays cast for the irradiance cache's direct light.
+    cache_rays: u64 => sum,
     /// Bright spots final gathering aims at.
-    pub spots: usize,
-    pub map_bytes: usize,
-    pub photon_rays: u64,
+    spots: usize => last,
+    map_bytes: usize => last,
+    photon_rays: u64 => sum,
     /// The camera pass's counters.
-    pub camera: Counters,
+    camera: Counters => merge,
     /// Pixels on the rim of a light's image, sampled with `edge_spp`.
-    pub edge_pixels: usize,
+    edge_pixels: usize => last,
     /// The emitted part's samples in each of them (`Settings::edge_spp`,
     /// or fewer where the rims are many).
-    pub edge_spp: u32,
-    pub photon_time: Duration,
+    edge_spp: u32 => last,
+    photon_time: Duration => sum,
     /// The map build: the photon maps (the caustic map's Morton sort and
     /// kd-tree, both maps' grids), then the irradiance cache (estimates at
     /// photons, their grid and tree).
-    pub tree_time: Duration,
-    pub cache_time: Duration,
-    pub camera_time: Duration,
+    tree_time: Duration => sum,
+    cache_time: Duration => sum,
+    camera_time: Duration => sum,
     /// Radius caps and photons per estimate (of the last pass when progressive).
-    pub r_global: f32,
-    pub r_caustic: f32,
-    pub k_global: usize,
-    pub k_caustic: usize,
+    r_global: f32 => last,
+    r_caustic: f32 => last,
+    k_global: usize => last,
+    k_caustic: usize => last,
     /// Passes rendered (1 for a classic render).
-    pub passes: u32,
+    passes: u32 => sum,
     /// Photon maps the scene cannot use, not built.
-    pub skipped_global: bool,
-    pub skipped_caustic: bool,
+    skipped_global: bool => last,
+    skipped_caustic: bool => last,
+}
+
+/// A statistic that joins a render's otherwise than by a sum.
+pub trait Absorb {
+    fn absorb(&mut self, pass: Self);
+}
+
+impl Absorb for Counters {
+    fn absorb(&mut self, pass: Counters) {
+        *self = self.merge(pass);
+    }
+}
+
+/// Per target, photons aimed and hits: added target by target (a later
+/// pass may know more targets).
+impl Absorb for Vec<(u32, u64, u64)> {
+    fn absorb(&mut self, pass: Self) {
+        if self.len() < pass.len() {
+            *self = pass.iter().map(|&(object, _, _)| (object, 0, 0)).collect();
+        }
+        for (a, b) in self.iter_mut().zip(&pass) {
+            a.1 += b.1;
+            a.2 += b.2;
+        }
+    }
 }
 
 impl Stats {
     pub fn build_time(&self) -> Duration {
         self.tree_time + self.cache_time
     }
-
-    /// Adds another pass's counts and times (maps' sizes are the last pass's).
-    pub fn absorb(&mut self, o: Stats) {
-        self.global_emitted += o.global_emitted;
-        self.global_landed += o.global_landed;
-        self.caustic_emitted += o.caustic_emitted;
-        self.caustic_aimed_hits += o.caustic_aimed_hits;
-        if self.caustic_targets.len() < o.caustic_targets.len() {
-            self.caustic_targets = o.caustic_targets.iter().map(|&(object, _, _)| (object, 0, 0)).collect();
-        }
-        for (a, b) in self.caustic_targets.iter_mut().zip(&o.caustic_targets) {
-            a.1 += b.1;
-            a.2 += b.2;
-        }
-        self.global_specular_hits += o.global_specular_hits;
-        self.photon_rays += o.photon_rays;
-        self.camera = self.camera.merge(o.camera);
-        self.photon_time += o.photon_time;
-        self.tree_time += o.tree_time;
-        self.cache_time += o.cache_time;
-        self.camera_time += o.camera_time;
-        self.passes += o.passes;
-        self.global_stored = o.global_stored;
-        self.caustic_stored = o.caustic_stored;
-        self.cache_points = o.cache_points;
-        self.spots = o.spots;
-        self.map_bytes = o.map_bytes;
-        self.edge_pixels = o.edge_pixels;
-        self.edge_spp = o.edge_spp;
-        self.r_global = o.r_global;
-        self.r_caustic = o.r_caustic;
-        self.k_global = o.k_global;
-        self.k_caustic = o.k_caustic;
-        self.skipped_global = o.skipped_global;
-        self.skipped_caustic = o.skipped_caustic;
-    }
 }
 
 /// `n` things, in the singular for one: "1 pass", "2 passes".
 pub fn counted(n: u64, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Counts add up, sizes and radii are the last pass's, targets add up
+    /// target by target.
+    #[test]
+    fn a_pass_joins_the_render_as_each_field_says() {
+        let pass = |i: u64| Stats {
+            global_emitted: 10 * i,
+            global_stored: i as usize,
+            cache_rays: 100,
+            caustic_targets: vec![(3, i, 1)],
+            camera: Counters { rays: 7, ..Counters::default() },
+            r_global: i as f32,
+            passes: 1,
+            photon_time: Duration::from_millis(5),
+            ..Stats::default()
+        };
+        let mut total = Stats::default();
+        for i in 1..=3 {
+            total.absorb(pass(i));
+        }
+        assert_eq!((total.global_emitted, total.global_stored, total.cache_rays), (60, 3, 300));
+        assert_eq!(total.caustic_targets, vec![(3, 6, 3)]);
+        assert_eq!((total.camera.rays, total.r_global, total.passes), (21, 3.0, 3));
+        assert_eq!(total.photon_time, Duration::from_millis(15));
+    }
 }

@@ -18,6 +18,7 @@ use crate::render::settings::{cache_stride, Settings};
 use crate::sampling::{stream, Domain};
 use crate::scene::Scene;
 use crate::stats::{Counters, Stats};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 /// Photon mapping: a pass is its photon stage ([`photon_pass`]) with the
@@ -105,10 +106,11 @@ impl RenderMethod for PhotonMapping {
             per_s(s.photon_rays, s.photon_time)
         ));
         out.push(format!(
-            "  map build    {:>8.3} s  (maps {:.3} s, irradiance cache {:.3} s)",
+            "  map build    {:>8.3} s  (maps {:.3} s, irradiance cache {:.3} s, {} shadow rays)",
             secs(s.build_time()),
             secs(s.tree_time),
-            secs(s.cache_time)
+            secs(s.cache_time),
+            s.cache_rays
         ));
         let camera = match st.aimed_rays() {
             0 => format!(", {} gather", st.gather_rays),
@@ -237,12 +239,15 @@ pub fn photon_pass(
     // their disk that lies on their surface.
     let coverage = |x, n, r| disk_coverage(scene, x, n, r, COVERAGE_SAMPLES);
     // The global map holds no photon's first hit: the cache adds the
-    // direct light by shadow rays.
+    // direct light by shadow rays (counted, whichever thread casts them).
+    let shadow_rays = AtomicU64::new(0);
     let direct = |i: u64, x, n| {
         let mut rng = stream(seed, Domain::CacheDirect, i);
         let mut counters = Counters::default();
         let mut ctx = Context { rng: &mut rng, counters: &mut counters, pixel: i };
-        direct_irradiance(scene, x, n, CACHE_SHADOW_RAYS, settings.skip, &mut ctx)
+        let e = direct_irradiance(scene, x, n, CACHE_SHADOW_RAYS, settings.skip, &mut ctx);
+        shadow_rays.fetch_add(counters.rays, Ordering::Relaxed);
+        e
     };
     let cache = IrradianceCache::build_with(&global_map, stride, est.k_global, est.r_global, &coverage, Some(&direct));
     let spots = if settings.aimed_rays() > 0 {
@@ -251,6 +256,7 @@ pub fn photon_pass(
         Vec::new()
     };
     stats.cache_time += t.elapsed();
+    stats.cache_rays += shadow_rays.into_inner();
     stats.spots = spots.len();
     stats.global_stored = global_map.len();
     stats.caustic_stored = caustic_map.len();
