@@ -19,7 +19,7 @@ pub struct Args {
     /// The scene file (omit it for the built-in room), then the XML to write.
     #[arg(value_name = "[SCENE.toml] OUT.xml", num_args = 1..=2, required = true)]
     paths: Vec<PathBuf>,
-    /// Built-in room: eye 1 = (-2,0,0), 2 = (-1,0,0).
+    /// Built-in room: eye 1 = (-2,0,0), 2 = (-1,0,0) [default: 1].
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2))]
     eye: Option<u8>,
     /// The point of the scene written as Mitsuba's origin [default: the

@@ -34,8 +34,10 @@ pub struct Args {
     /// A rectangle whose predicted error is reported, as for rendering.
     #[arg(long = "window", value_name = "[NAME=]R0:R1,C0:C1")]
     windows: Vec<String>,
+    /// How 8-bit outputs are made from radiance, as for rendering.
     #[arg(long, value_enum, default_value_t = Named(ToneMap::Display))]
     tonemap: Named<ToneMap>,
+    /// Brightness factor of 8-bit outputs, as for rendering.
     #[arg(long, default_value_t = 1.0, value_parser = parse_exposure)]
     exposure: f32,
     /// No summary.

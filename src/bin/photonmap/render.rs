@@ -117,7 +117,8 @@ pub struct RenderArgs {
     /// Seed of every random stream: the same image on any number of threads.
     #[arg(long, default_value_t = DEFAULT.seed, value_parser = parse_seed)]
     seed: u64,
-    /// Eye position: 1 = (-2,0,0), 53 degree view; 2 = (-1,0,0), 90 degrees.
+    /// Eye position of the built-in room: 1 = (-2,0,0), 53 degree view;
+    /// 2 = (-1,0,0), 90 degrees [default: 1].
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2))]
     eye: Option<u8>,
     /// Worker threads [default: all cores].
