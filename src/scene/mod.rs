@@ -7,18 +7,22 @@ use crate::accel::Accel;
 use crate::camera::Camera;
 use crate::light::{AreaLight, Light};
 use crate::material::Material;
-use crate::math::{max_component, offset_ray_origin, Color, Frame, Ray, Vertex};
+use crate::math::{max_component, Color, Ray, Vertex};
 use crate::sampling::Discrete;
 pub mod file;
+mod hit;
 pub mod mesh;
 pub mod mitsuba;
 pub mod ply;
 pub mod procedural;
 mod room;
 pub mod serialized;
+mod texturing;
 pub mod vol;
 
+pub use hit::Hit;
 pub use room::{tncg15_room, Eye};
+pub use texturing::Texturing;
 
 use crate::shape::{Departure, Shape, ShapeHit};
 use glam::{Vec2, Vec3};
@@ -31,111 +35,6 @@ pub struct Prim {
     pub shape: Shape,
     pub material: u32,
     pub object: u32,
-}
-
-/// A ray's nearest intersection with the scene.
-#[derive(Clone, Copy, Debug)]
-pub struct Hit {
-    pub t: f32,
-    pub point: Vertex,
-    pub p_err: Vec3,
-    /// Geometric normal as the shape defines it.
-    pub normal: Vec3,
-    /// The normal shading uses: interpolated from a mesh's vertex normals,
-    /// else the geometric one. On the geometric normal's side, unit.
-    pub shading_normal: Vec3,
-    pub prim: u32,
-    /// A triangle's barycentric weights of its second and third corners
-    /// (zero on other shapes): where textures and attributes are read.
-    pub bary: Vec2,
-    /// The shading frame's first axis (unit, perpendicular to the shading
-    /// normal) where the surface's texture coordinates give one; zero
-    /// elsewhere, and the frame is the normal's own.
-    pub tangent: Vec3,
-}
-
-impl Hit {
-    /// The geometric normal turned to the side the ray `dir` arrived from.
-    #[inline]
-    pub fn facing_normal(&self, dir: Vec3) -> Vec3 {
-        if self.normal.dot(dir) < 0.0 {
-            self.normal
-        } else {
-            -self.normal
-        }
-    }
-
-    /// The frame in which `material` scatters a ray that arrived travelling
-    /// along `dir`: the shading normal's, turned to the ray's side (z is the
-    /// normal, `-dir` has z > 0); the geometric normal's where there is no
-    /// shading normal, or where the shading normal would send the arriving
-    /// ray, or a perfect reflection or refraction of it, to the wrong side
-    /// of the actual surface (a smooth mesh at grazing angles: light would
-    /// leak through it, or be lost). Also whether the ray arrived on the
-    /// front of the geometric normal (glass: entering).
-    #[inline]
-    pub fn scattering_frame(&self, dir: Vec3, material: &crate::material::Material) -> (Frame, bool) {
-        let entering = dir.dot(self.normal) < 0.0;
-        let geometric = self.facing_normal(dir);
-        if self.shading_normal == self.normal {
-            return (self.frame_about(geometric), entering);
-        }
-        let n = if entering { self.shading_normal } else { -self.shading_normal };
-        let frame = self.frame_about(n);
-        let wo = frame.to_local(-dir);
-        let sides_kept = wo.z > 0.0
-            && material
-                .specular_branches(wo, entering, crate::material::Transport::Radiance)
-                .iter()
-                .all(|b| (frame.to_world(b.wi).dot(geometric) > 0.0) == (b.wi.z > 0.0));
-        if sides_kept {
-            (frame, entering)
-        } else {
-            (self.frame_about(geometric), entering)
-        }
-    }
-
-    /// The frame about unit normal `n`: along the hit's tangent where it has one.
-    #[inline]
-    fn frame_about(&self, n: Vec3) -> Frame {
-        if self.tangent == Vec3::ZERO {
-            return Frame::from_normal(n);
-        }
-        let s = crate::texture::tangent_of(n, self.tangent);
-        Frame { s, t: n.cross(s), n }
-    }
-
-    /// Whether unit `dir`, leaving the surface for a ray that arrived along
-    /// `arrived`, goes where the scattering said: to the side it arrived
-    /// from for a reflection (`reflected`), through for a refraction.
-    #[inline]
-    pub fn leaves_as(&self, arrived: Vec3, dir: Vec3, reflected: bool) -> bool {
-        (dir.dot(self.normal) * arrived.dot(self.normal) < 0.0) == reflected
-    }
-
-    /// The factor a photon's power takes, for shading normals, when it
-    /// arrives along `arrived` and leaves along `left` (Veach 1997, eq.
-    /// 5.21): the adjoint of a BSDF with shading normals is not the BSDF.
-    /// 1 where the shading normal is the geometric one.
-    #[inline]
-    pub fn adjoint_correction(&self, arrived: Vec3, left: Vec3) -> f32 {
-        if self.shading_normal == self.normal {
-            return 1.0;
-        }
-        let (ns, ng) = (self.shading_normal, self.normal);
-        let denominator = arrived.dot(ng).abs() * left.dot(ns).abs();
-        if !(denominator > 0.0) {
-            return 0.0;
-        }
-        arrived.dot(ns).abs() * left.dot(ng).abs() / denominator
-    }
-
-    /// A ray leaving this hit along unit `dir`, with its departure record.
-    #[inline]
-    pub fn spawn(&self, dir: Vec3) -> (Ray, Departure) {
-        let origin = offset_ray_origin(self.point, self.p_err, self.normal, dir);
-        (Ray::new(origin, dir), Departure { prim: self.prim, outward: dir.dot(self.normal) > 0.0 })
-    }
 }
 
 pub struct Scene {
@@ -174,81 +73,6 @@ pub struct Scene {
     /// Participating media; `None` in a scene without, which then pays
     /// nothing for them.
     media: Option<Box<crate::medium::Media>>,
-}
-
-/// A scene's textures ([`crate::texture`]): the textures, the materials
-/// that read them, and where on each primitive they are read.
-#[derive(Clone, Debug, Default)]
-pub struct Texturing {
-    pub textures: Vec<crate::texture::Texture>,
-    /// Per material: its recipe where it is textured (as long as the
-    /// materials, or shorter: the rest are plain).
-    pub materials: Vec<Option<crate::material::Textured>>,
-    /// Per primitive: its texture coordinates (as long as the primitives,
-    /// or shorter: the rest use their barycentrics).
-    pub surfaces: Vec<crate::texture::SurfaceUv>,
-    /// The analytic shapes' world-to-object transforms that `surfaces` name.
-    pub frames: Vec<glam::Affine3A>,
-    /// Per material: the normal or bump map it is seen through, if any.
-    pub perturb: Vec<Option<crate::texture::Perturb>>,
-    /// Per light of the scene's parts: an image over a triangle light.
-    pub light_patterns: Vec<Option<std::sync::Arc<crate::light::AreaPattern>>>,
-}
-
-impl Texturing {
-    /// Whether any material reads a texture.
-    pub fn is_used(&self) -> bool {
-        self.materials.iter().any(Option::is_some) || self.perturb.iter().any(Option::is_some)
-    }
-
-    /// Gives `hit` its shading frame from the texture coordinates, bent by
-    /// the material's normal or bump map.
-    #[inline(never)]
-    fn shade(&self, hit: &mut Hit, shape: &Shape, material: u32) {
-        let Some(surface) = self.surfaces.get(hit.prim as usize) else { return };
-        let tangents = crate::texture::tangents(surface, shape, hit.point, &self.frames);
-        hit.tangent = crate::texture::tangent_of(hit.shading_normal, tangents.0);
-        if let Some(Some(p)) = self.perturb.get(material as usize) {
-            let at = self.point(hit);
-            if let Some((n, s)) = p.apply(&at, &self.textures, hit.shading_normal, hit.normal, tangents) {
-                if n.dot(hit.normal) > 0.0 {
-                    (hit.shading_normal, hit.tangent) = (n, s);
-                }
-            }
-        }
-    }
-
-    /// Material `m`, or where it is a blend, the material of it that `hit`
-    /// shows a ray travelling along `dir` (nests of blends followed down).
-    #[inline]
-    fn pick(&self, hit: &Hit, dir: Vec3, mut m: usize) -> usize {
-        let mut depth = 0;
-        // The front-ends make no cycle; the bound keeps a malformed one finite.
-        while let Some(Some(crate::material::Textured::Blend { weight, first, second })) = self.materials.get(m) {
-            if depth == 64 {
-                break;
-            }
-            let w = match weight {
-                crate::material::Param::Fixed(c) => c.x,
-                p => p.number(&self.point(hit), &self.textures),
-            };
-            let mix = crate::material::hit_random(hit.point, dir, depth);
-            m = if mix < w { *second } else { *first } as usize;
-            depth += 1;
-        }
-        m
-    }
-
-    /// Where textures are read at `hit`.
-    #[inline]
-    pub fn point(&self, hit: &Hit) -> crate::texture::SurfacePoint {
-        let surface = self.surfaces.get(hit.prim as usize).copied().unwrap_or(crate::texture::SurfaceUv::Barycentric);
-        crate::texture::SurfacePoint {
-            uv: surface.uv(hit.point, hit.bary, &self.frames),
-            prim: hit.prim,
-            bary: hit.bary,
-        }
-    }
 }
 
 /// Marks a primitive that is not a light's surface.
