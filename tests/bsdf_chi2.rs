@@ -8,9 +8,9 @@
 
 mod common;
 
-use common::chi2::{gamma_q, Chi2, Outcome};
+use common::chi2::{gamma_q, Chi2};
 use glam::Vec3;
-use photonmap::material::{Distribution, Lobe, Material, Microfacet, Phong, Transport};
+use photonmap::material::{Distribution, Material, Microfacet, Phong};
 use photonmap::math::Color;
 use photonmap::sampling::{next_2d, stream, Domain};
 
@@ -28,35 +28,9 @@ const DISTRIBUTIONS: [Distribution; 2] = [Distribution::Beckmann, Distribution::
 /// (alpha_u, alpha_v): smooth-ish, rough, anisotropic.
 const ROUGHNESS: [(f32, f32); 3] = [(0.1, 0.1), (0.45, 0.45), (0.12, 0.5)];
 
-/// One material's test from `wo`: its sample against its pdf.
-fn material_outcome(m: &Material, wo: Vec3, entering: bool, seed: u64, tests: usize) -> Outcome {
-    let mut rng = stream(seed, Domain::Camera, 0);
-    let chi2 = Chi2 { tests, ..Chi2::default() };
-    chi2.run(
-        || {
-            m.sample(wo, entering, Transport::Radiance, &mut rng)
-                .filter(|s| s.lobe != Lobe::Specular)
-                .map(|s| s.wi.normalize())
-        },
-        |wi| m.pdf(wo, wi, entering) as f64,
-    )
-}
-
 /// Runs every case, and fails listing those that fail.
 fn check_all(family: &str, cases: Vec<(String, Material, Vec3, bool)>) {
-    let n = cases.len();
-    let mut failed = Vec::new();
-    for (i, (name, m, wo, entering)) in cases.into_iter().enumerate() {
-        let o = material_outcome(&m, wo, entering, 1000 + i as u64, n);
-        println!(
-            "{family} {name} wo {wo:.2} entering {entering}: chi2 {:.1} dof {} p {:.4} (level {:.5}) pdf mass {:.4}",
-            o.statistic, o.dof, o.p_value, o.threshold, o.pdf_mass
-        );
-        if !o.passed() {
-            failed.push(format!("{name} wo {wo}: p {}", o.p_value));
-        }
-    }
-    assert!(failed.is_empty(), "{family}: {failed:?}");
+    common::material_chi2::check_all(family, cases, Chi2::default().samples, 1000);
 }
 
 #[test]

@@ -9,9 +9,8 @@
 
 mod common;
 
-use common::chi2::{Chi2, Outcome};
 use glam::Vec3;
-use photonmap::material::{Blend, Distribution, Lobe, Masked, Material, Phong, Principled, PrincipledThin, Transport};
+use photonmap::material::{Blend, Distribution, Masked, Material, Phong, Principled, PrincipledThin, Transport};
 use photonmap::math::Color;
 use photonmap::sampling::{next_2d, stream, uniform_cone, Domain};
 
@@ -190,43 +189,18 @@ fn sides(m: &Material) -> &'static [bool] {
     }
 }
 
-fn chi2_of(m: &Material, wo: Vec3, entering: bool, seed: u64, tests: usize) -> Outcome {
-    let mut rng = stream(seed, Domain::Camera, 0);
-    let chi2 = Chi2 { tests, samples: 200_000, ..Chi2::default() };
-    chi2.run(
-        || {
-            m.sample(wo, entering, Transport::Radiance, &mut rng)
-                .filter(|s| s.lobe != Lobe::Specular)
-                .map(|s| s.wi.normalize())
-        },
-        |wi| m.pdf(wo, wi, entering) as f64,
-    )
-}
-
 /// Every variant has a case, and its smooth samples follow its pdf from
 /// every incidence and side (the specular branches, deltas, left out: the
 /// pdf's mass is the rest).
 #[test]
 fn every_material_samples_follow_its_pdf() {
-    let cases: Vec<(&str, Material, Vec3, bool)> = every()
+    let cases: Vec<(String, Material, Vec3, bool)> = every()
         .into_iter()
         .flat_map(|(name, m, _, _)| {
-            incidences().into_iter().flat_map(move |wo| sides(&m).iter().map(move |&e| (name, m, wo, e)))
+            incidences().into_iter().flat_map(move |wo| sides(&m).iter().map(move |&e| (name.to_string(), m, wo, e)))
         })
         .collect();
-    let n = cases.len();
-    let mut failed = Vec::new();
-    for (i, (name, m, wo, entering)) in cases.into_iter().enumerate() {
-        let o = chi2_of(&m, wo, entering, 300 + i as u64, n);
-        println!(
-            "{name} wo {wo:.2} entering {entering}: chi2 {:.1} dof {} p {:.4} (level {:.5}) pdf mass {:.4}",
-            o.statistic, o.dof, o.p_value, o.threshold, o.pdf_mass
-        );
-        if !o.passed() {
-            failed.push(format!("{name} wo {wo} entering {entering}: p {}", o.p_value));
-        }
-    }
-    assert!(failed.is_empty(), "{failed:?}");
+    common::material_chi2::check_all("every", cases, 200_000, 300);
 }
 
 /// The mean weight of `n` samples from `wo`: what the material carries on.

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod chi2;
+pub mod material_chi2;
 
 use photonmap::film::Film;
 use photonmap::metrics::{compare, Metrics};
