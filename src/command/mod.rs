@@ -6,7 +6,8 @@
 //!   passes, on from a partial), with [`load`], [`checks`],
 //!   [`observers`], [`outputs`] and [`summary`];
 //! * [`merge`]: partial renders added into one image;
-//! * [`trace`]: the Whitted tracer's render.
+//! * [`trace`]: the Whitted tracer's render;
+//! * [`values`]: what a valid option value is.
 
 pub mod checks;
 pub mod compare;
@@ -19,3 +20,4 @@ pub mod outputs;
 pub mod render;
 pub mod summary;
 pub mod trace;
+pub mod values;

@@ -1,7 +1,7 @@
 //! `photonmap compare TEST.exr REF.exr`: the flags of
 //! `photonmap::command::compare`.
 
-use crate::args::parse_windows;
+use crate::args::{parse_difference, parse_windows};
 use photonmap::command::compare::{self, Request};
 use photonmap::error::Error;
 use std::io::Write;
@@ -46,18 +46,11 @@ pub struct Args {
     diff: Option<PathBuf>,
     /// The difference that the picture shows at full intensity [default:
     /// the 99th percentile of the absolute differences].
-    #[arg(long, value_name = "D", value_parser = parse_scale)]
+    #[arg(long, value_name = "D", value_parser = parse_difference)]
     diff_scale: Option<f32>,
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
-}
-
-fn parse_scale(s: &str) -> Result<f32, String> {
-    match s.parse::<f32>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("'{s}' must be a positive difference")),
-    }
 }
 
 pub fn run(args: Args) -> Result<(), Error> {

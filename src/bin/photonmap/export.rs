@@ -2,6 +2,7 @@
 //! `photonmap::command::export`.
 
 use photonmap::command::export::{self, Request};
+use photonmap::command::values::parse_point;
 use photonmap::error::Error;
 use std::path::PathBuf;
 
@@ -34,17 +35,6 @@ pub struct Args {
     /// the distance from the origin.
     #[arg(long, default_value_t = 1.0)]
     scale: f32,
-}
-
-fn parse_point(text: &str) -> Result<glam::Vec3, String> {
-    let v: Vec<f32> = text
-        .split(',')
-        .map(|c| c.trim().parse::<f32>().map_err(|e| format!("{c:?}: {e}")))
-        .collect::<Result<_, _>>()?;
-    match v.as_slice() {
-        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(glam::Vec3::new(*x, *y, *z)),
-        _ => Err("give three finite numbers, X,Y,Z".into()),
-    }
 }
 
 pub fn run(args: Args) -> Result<(), Error> {
