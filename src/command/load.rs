@@ -83,17 +83,17 @@ pub fn load(req: &Request) -> Result<Loaded, Error> {
         }
     };
     wait.finish();
-    if scene.media().is_some() && method == Method::Photon {
-        // Photon mapping does not yet carry light through media.
-        if req.method == Some(Method::Photon) {
-            return Err(Error::Invalid(format!(
-                "{}: photon mapping does not render participating media yet; render with --integrator path",
-                id.name
-            )));
-        }
+    if scene.media().is_some() && method == Method::Photon && req.method.is_none() {
+        // Without a method asked, a scene with media is path traced: the
+        // unbiased estimate Mitsuba's acceptance test measures its scenes
+        // with (volumetric photon mapping is asked for by name).
         method = Method::Path;
         if !req.quiet {
-            eprintln!("photonmap: {}: the scene has participating media: rendering with --integrator path", id.name);
+            eprintln!(
+                "photonmap: {}: the scene has participating media: rendering with --integrator path \
+                 (--integrator photon for volumetric photon mapping)",
+                id.name
+            );
         }
     }
     Ok(Loaded { scene, spp, id, method })

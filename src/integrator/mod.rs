@@ -17,6 +17,7 @@ pub mod path;
 pub mod photon;
 pub mod unseen;
 pub mod volpath;
+pub mod volphoton;
 pub mod whitted;
 
 pub use direct::{direct_irradiance, direct_light, direct_light_mis, direct_light_one_at_a_time, MisBsdf};

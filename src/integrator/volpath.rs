@@ -183,7 +183,7 @@ pub(super) fn radiance(pt: &PathIntegrator, media: &Media, ray: Ray, part: Part,
         vertices += 1;
         let smooth = scatter.lobe != Lobe::Specular;
         if material.has_smooth_lobes() && within(vertices + 1) {
-            let direct = surface_light(scene, media, &hit, &material, &frame, wo, entering, medium, ctx);
+            let direct = surface_light(scene, media, &hit, &material, &frame, wo, entering, medium, true, ctx);
             radiance += throughput * ctx.checked(direct, "volpath surface light");
         }
         let dir = frame.to_world(scatter.wi).normalize();
@@ -216,7 +216,7 @@ pub(super) fn radiance(pt: &PathIntegrator, media: &Media, ray: Ray, part: Part,
 /// seen through a medium that scatters is the reflected part's: its image
 /// there is a glow, which the extra samples the camera pass gives the
 /// emitted part at the rims of lights' images would not sharpen.
-fn emitted_part(scene: &Scene, media: &Media, mut ray: Ray, ctx: &mut Context) -> Color {
+pub(super) fn emitted_part(scene: &Scene, media: &Media, mut ray: Ray, ctx: &mut Context) -> Color {
     let limits = scene.paths;
     let within = |vertices: u32| limits.max_depth.is_none_or(|m| vertices <= m);
     let (mut departure, mut medium) = (None, media.camera);
@@ -268,7 +268,7 @@ fn emitted_part(scene: &Scene, media: &Media, mut ray: Ray, ctx: &mut Context) -
 /// Russian roulette after [`RR_DEPTH`] vertices: whether the path goes on
 /// (its weight divided by the chance it did).
 #[inline]
-fn roulette(throughput: &mut Color, vertices: u32, ctx: &mut Context) -> bool {
+pub(super) fn roulette(throughput: &mut Color, vertices: u32, ctx: &mut Context) -> bool {
     if vertices >= RR_DEPTH {
         let q = max_component(*throughput).min(0.95);
         if !(ctx.rng.random::<f32>() < q) {
@@ -314,9 +314,10 @@ fn medium_light(
 }
 
 /// Light reflected at a surface vertex straight from one light drawn by
-/// power, by a shadow ray weighted against the BSDF's density.
+/// power, by a shadow ray weighted against the BSDF's density (`mis`;
+/// else counted in full).
 #[allow(clippy::too_many_arguments)]
-fn surface_light(
+pub(super) fn surface_light(
     scene: &Scene,
     media: &Media,
     hit: &Hit,
@@ -325,6 +326,7 @@ fn surface_light(
     wo: Vec3,
     entering: bool,
     medium: Option<u32>,
+    mis: bool,
     ctx: &mut Context,
 ) -> Color {
     let Some((index, chance)) = scene.pick_light_index(ctx.rng.random::<f32>()) else { return Color::ZERO };
@@ -349,7 +351,7 @@ fn surface_light(
     if tr == Color::ZERO {
         return Color::ZERO;
     }
-    let w = if light.is_delta() {
+    let w = if light.is_delta() || !mis {
         1.0
     } else {
         let pdf = material.pdf(wo, wi, entering);
@@ -364,7 +366,7 @@ fn surface_light(
 /// transmittance along it and what each index-matched surface it crosses
 /// lets through; zero where any other surface blocks it.
 #[allow(clippy::too_many_arguments)]
-fn transmittance(
+pub(super) fn transmittance(
     scene: &Scene,
     media: &Media,
     mut ray: Ray,
@@ -416,7 +418,7 @@ pub fn passes_straight(material: &Material, cos: f32) -> Color {
 /// sampling is by the cosine about a surface's normal), every other
 /// light by its own sampling.
 #[inline]
-fn sample_li_everywhere(light: &Light, p: Vec3, u: glam::Vec2) -> Option<Incident> {
+pub(super) fn sample_li_everywhere(light: &Light, p: Vec3, u: glam::Vec2) -> Option<Incident> {
     match light {
         Light::Constant(c) => {
             let dir = crate::sampling::uniform_cone(u, -1.0).normalize();

@@ -23,10 +23,12 @@
 //! keeps every channel unbiased.
 
 pub mod phase;
+mod segment;
 pub mod vol_file;
 pub mod volume;
 
 pub use phase::Phase;
+pub use segment::Steps;
 pub use vol_file::{VolError, VolGrid};
 pub use volume::{Aabb, Filter, Grid, Volume, Wrap};
 

@@ -18,8 +18,10 @@ mod grid;
 pub mod irradiance_cache;
 mod kdtree;
 pub mod map;
+pub mod media_trace;
 pub mod spots;
 pub mod trace;
+pub mod volume_map;
 
 pub use blocks::PhotonBlocks;
 

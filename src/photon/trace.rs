@@ -132,21 +132,21 @@ pub fn trace_pass_with(
 
 /// At most this many times the photons asked for are emitted where most
 /// miss the scene.
-const MAX_EXTRA: u64 = 16;
+pub(crate) const MAX_EXTRA: u64 = 16;
 
 /// Photons of the pilot that measures what share of a pass lands.
 const PILOT: u64 = 4096;
 
 /// Whether light from infinity (a sky, an environment map) lights the
 /// scene: its photons come from outside, and some miss everything.
-fn lit_from_outside(scene: &Scene) -> bool {
+pub(crate) fn lit_from_outside(scene: &Scene) -> bool {
     scene.lights.iter().any(|l| matches!(l, crate::light::Light::Constant(_) | crate::light::Light::Envmap(_)))
 }
 
 /// The share of the global pass's photons whose first ray meets the
 /// scene, measured on a pilot of its own random streams (indices past any
 /// pass's), so the same seed gives the same count.
-fn landing_fraction(scene: &Scene, seed: u64) -> f64 {
+pub(crate) fn landing_fraction(scene: &Scene, seed: u64) -> f64 {
     let first = u64::MAX - PILOT;
     let landed = (first..first + PILOT)
         .into_par_iter()

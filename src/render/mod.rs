@@ -7,6 +7,7 @@
 pub mod camera_pass;
 pub mod driver;
 pub mod error_estimate;
+pub mod media_stage;
 pub mod method;
 pub mod photon_stage;
 mod rims;

@@ -42,6 +42,9 @@ impl RenderMethod for PhotonMapping {
         stats: &mut Stats,
     ) -> Film {
         let settings = &self.settings;
+        if let Some(media) = scene.media() {
+            return super::media_stage::media_pass(settings, scene, media, camera, progress, rims, stats);
+        }
         let est = Estimates::progressive(scene, settings, camera.pass as u32);
         (stats.r_global, stats.r_caustic, stats.k_global, stats.k_caustic) =
             (est.r_global, est.r_caustic, est.k_global, est.k_caustic);

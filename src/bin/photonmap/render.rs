@@ -47,7 +47,8 @@ pub struct RenderArgs {
     /// Estimator: photon (photon mapping) or path (path tracing with
     /// next-event estimation, unbiased: the reference). Default: photon;
     /// path for a Mitsuba scene whose integrator stops paths at 3 or more
-    /// vertices (max_depth), which photon mapping cannot do.
+    /// vertices (max_depth), which photon mapping cannot do, and for a
+    /// scene with participating media (photon: volumetric photon mapping).
     #[arg(long, value_enum)]
     integrator: Option<Named<Method>>,
     /// Progressive rendering: passes 0 to N-1, averaged (with --resume:

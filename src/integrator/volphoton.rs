@@ -1,0 +1,248 @@
+//! Photon mapping's camera pass in a scene with participating media
+//! (Jensen and Christensen 1998; the beam radiance estimate of Jarosz,
+//! Zwicker and Jensen 2008). A camera path follows mirrors, glass,
+//! index-matched crossings and glossy lobes; each light path reaching the
+//! eye is counted by exactly one estimator (notes/method.md §8):
+//!
+//! | light path                    | estimator                                   |
+//! |-------------------------------|---------------------------------------------|
+//! | L E, L S+ E (through media)   | emission met, times transmittance           |
+//! | L V (S\|G)* E                 | single scattering: a distance drawn along   |
+//! |                               | each camera segment, a shadow ray to a light|
+//! | L S+ V (S\|G)* E              | volume caustic map, beam estimate           |
+//! | L …(D\|V)… V (S\|G)* E        | volume map, beam estimate                   |
+//! | L D (S\|G)* E                 | shadow rays at the diffuse or glossy vertex |
+//! | L …(S\|D\|V)… D (S\|G)* E     | surface map (global and caustic photons),   |
+//! |                               | read directly at the diffuse vertex         |
+//! | L S+ G (S\|G)* E              | emission met after the specular chain       |
+//!
+//! Transmittance is exact in homogeneous media and estimated by ratio
+//! tracking in heterogeneous ones; surfaces behind a medium are seen
+//! through it. The maps are read directly (no final gathering), so their
+//! radii shrink from pass to pass as progressive photon mapping's do.
+
+use super::volpath::{emitted_part, roulette, sample_li_everywhere, surface_light, transmittance};
+use super::{Context, Integrator, Part};
+use crate::material::Transport;
+use crate::math::{max_component, Color, Ray};
+use crate::medium::{Media, Medium, Steps};
+use crate::photon::map::{PhotonMap, Scratch};
+use crate::photon::volume_map::VolumeMap;
+use crate::sampling::next_2d;
+use crate::scene::Scene;
+use crate::shape::Departure;
+use rand::RngExt;
+
+/// Hard cap on a camera path's events (vertices and crossings).
+const MAX_EVENTS: u32 = 256;
+
+/// The estimator over one pass's maps.
+pub struct VolPhotonIntegrator<'a> {
+    pub scene: &'a Scene,
+    pub media: &'a Media,
+    /// Photons on diffuse surfaces: every path but light straight from a
+    /// light.
+    pub surface: &'a PhotonMap,
+    /// Photons scattered in media after a diffuse or medium vertex.
+    pub volume: &'a VolumeMap,
+    /// Photons scattered in media straight after mirrors and glass.
+    pub volume_caustic: &'a VolumeMap,
+    /// The surface map's k nearest photons and radius cap.
+    pub k: usize,
+    pub r_max: f32,
+    /// Single-scattering samples per camera segment in a medium,
+    /// stratified along it.
+    pub single_samples: u32,
+}
+
+/// A thread's scratch space.
+#[derive(Default)]
+pub struct VolPhotonThread {
+    scratch: Scratch,
+    steps: Steps,
+}
+
+impl Integrator for VolPhotonIntegrator<'_> {
+    type Thread = VolPhotonThread;
+    type Pixel = ();
+
+    fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context, thread: &mut VolPhotonThread, _: &mut ()) -> Color {
+        if part == Part::Emitted {
+            return emitted_part(self.scene, self.media, ray, ctx);
+        }
+        self.path(ray, part, ctx, thread)
+    }
+}
+
+impl VolPhotonIntegrator<'_> {
+    fn path(&self, mut ray: Ray, part: Part, ctx: &mut Context, thread: &mut VolPhotonThread) -> Color {
+        let (scene, media) = (self.scene, self.media);
+        let hide_emitters = scene.paths.hide_emitters;
+        let mut radiance = Color::ZERO;
+        let mut throughput = Color::ONE;
+        let mut departure: Option<Departure> = None;
+        let mut medium = media.camera;
+        // Vertices so far (crossings are none); whether all were specular
+        // and no segment crossed a scattering medium (light met is then
+        // the emitted part's); whether light met now is this estimator's
+        // (no shadow ray could have found it).
+        let (mut vertices, mut specular_chain, mut count_emitted) = (0u32, true, true);
+        for _ in 0..MAX_EVENTS {
+            ctx.counters.rays += 1;
+            let hit = scene.intersect(&ray, departure);
+            let t_surface = hit.as_ref().map_or(f32::INFINITY, |h| h.t);
+            if let Some(m) = medium {
+                let med = media.get(m);
+                let tr = med.track(&ray, t_surface, ctx.rng, &mut thread.steps);
+                if med.scatters() {
+                    specular_chain = false;
+                    let inscattered = self.segment(med, m, &ray, t_surface, ctx, thread);
+                    radiance += throughput * ctx.checked(inscattered, "medium");
+                }
+                throughput *= tr;
+            }
+            if !(max_component(throughput) > 0.0) {
+                break;
+            }
+            let seen = (part == Part::All || !specular_chain) && count_emitted && !(vertices == 0 && hide_emitters);
+            let Some(hit) = hit else {
+                if seen {
+                    radiance += throughput * scene.background(ray.dir);
+                }
+                break;
+            };
+            throughput *= scene.transmittance(departure, hit.t);
+            if seen {
+                radiance += throughput * scene.emitted(&hit, ray.dir);
+            }
+            let material = scene.material_seen(&hit, ray.dir);
+            if material.is_emitter() {
+                break;
+            }
+            let (frame, entering) = hit.scattering_frame(ray.dir, &material);
+            let wo = frame.to_local(-ray.dir);
+            if material.has_smooth_lobes() {
+                let direct = surface_light(scene, media, &hit, &material, &frame, wo, entering, medium, false, ctx);
+                let mut reflected = ctx.checked(direct, "direct");
+                if material.diffuse_rho().is_some() {
+                    let rho = material.diffuse_albedo(wo);
+                    let r =
+                        self.surface.radiance_cone(hit.point, frame.n, rho, self.k, self.r_max, &mut thread.scratch);
+                    reflected += ctx.checked(r, "surface map");
+                }
+                radiance += throughput * reflected;
+            }
+            // The path goes on by a specular branch or the glossy lobe
+            // (each, where there are both, half the time).
+            let branches = material.specular_branches(wo, entering, Transport::Radiance);
+            let glossy = material.glossy();
+            let both = !branches.is_empty() && glossy.is_some();
+            let pick_glossy = glossy.is_some() && (!both || ctx.rng.random::<f32>() < 0.5);
+            let split = if both { 2.0 } else { 1.0 };
+            let (wi, weight, is_glossy) = if pick_glossy {
+                let Some(g) = glossy else { break };
+                let Some((wi, w)) = g.sample(wo, entering, Transport::Radiance, ctx.rng) else { break };
+                (wi, w, true)
+            } else {
+                let several = branches.iter().count() > 1;
+                let Some(b) = branches.choose(ctx.rng) else { break };
+                (b.wi, if several { b.scale } else { b.scale * b.prob }, false)
+            };
+            throughput *= weight * split;
+            if !is_glossy && wi == -wo {
+                // Straight through an index-matched surface.
+                medium = media.after(medium, hit.prim, hit.normal, ray.dir);
+                let (next, dep) = hit.spawn(ray.dir);
+                (ray, departure) = (next, Some(dep));
+                continue;
+            }
+            let dir = frame.to_world(wi).normalize();
+            if hit.shading_normal != hit.normal && !hit.leaves_as(ray.dir, dir, wi.z > 0.0) {
+                break;
+            }
+            vertices += 1;
+            count_emitted = !is_glossy;
+            specular_chain &= !is_glossy;
+            medium = media.after(medium, hit.prim, hit.normal, dir);
+            let (next, dep) = hit.spawn(dir);
+            (ray, departure) = (next, Some(dep));
+            if !roulette(&mut throughput, vertices, ctx) {
+                break;
+            }
+        }
+        radiance
+    }
+
+    /// Light scattered towards the eye along the camera segment `ray` over
+    /// [0, `t_max`] in medium `m` (whose transmittance [`Medium::track`]
+    /// left in the thread's steps): single scattering by shadow rays, the
+    /// rest by the volume maps' beam estimates.
+    fn segment(
+        &self,
+        med: &Medium,
+        m: u32,
+        ray: &Ray,
+        t_max: f32,
+        ctx: &mut Context,
+        thread: &mut VolPhotonThread,
+    ) -> Color {
+        let steps = &thread.steps;
+        let mut sum = Color::ZERO;
+        for map in [self.volume, self.volume_caustic] {
+            map.beam(ray, t_max, |c| {
+                if c.photon.medium == m {
+                    let f = med.phase.eval(c.photon.direction(), -ray.dir);
+                    sum += c.photon.power * (f * c.kernel) * med.transmittance_to(steps, c.t);
+                }
+            });
+        }
+        // The samples stratified along the segment (in the distances'
+        // distribution): a shaft of light crossing a small part of it is
+        // met by some of them in every camera ray.
+        let n = self.single_samples.max(1);
+        let mut single = Color::ZERO;
+        for i in 0..n {
+            let u = (i as f32 + ctx.rng.random::<f32>()) / n as f32;
+            single += self.single_scattering(med, m, ray, t_max, u, ctx, steps);
+        }
+        sum + single / n as f32
+    }
+
+    /// One estimate of the light scattered once along the segment: a
+    /// distance drawn along it (`u`: its place in their distribution), one
+    /// light drawn by power, a shadow ray.
+    #[allow(clippy::too_many_arguments)]
+    fn single_scattering(
+        &self,
+        med: &Medium,
+        m: u32,
+        ray: &Ray,
+        t_max: f32,
+        u: f32,
+        ctx: &mut Context,
+        steps: &Steps,
+    ) -> Color {
+        let channel = ctx.rng.random::<f32>();
+        let Some((t, pdf_t)) = med.sample_along(ray, t_max, glam::Vec2::new(channel, u)) else {
+            return Color::ZERO;
+        };
+        let p = ray.at(t);
+        let (_, sigma_s) = med.coefficients(p);
+        if sigma_s == Color::ZERO {
+            return Color::ZERO;
+        }
+        let scene = self.scene;
+        let Some((index, chance)) = scene.pick_light_index(ctx.rng.random::<f32>()) else { return Color::ZERO };
+        let Some(inc) = sample_li_everywhere(&scene.lights[index], p, next_2d(ctx.rng)) else { return Color::ZERO };
+        let f = med.phase.eval(ray.dir, inc.dir);
+        if !(f > 0.0) || inc.intensity == Color::ZERO {
+            return Color::ZERO;
+        }
+        let reach = inc.target.map_or(f32::INFINITY, |y| (y - p).length());
+        let shadow = transmittance(scene, self.media, Ray::new(p, inc.dir), None, reach, inc.prim, Some(m), ctx);
+        if shadow == Color::ZERO {
+            return Color::ZERO;
+        }
+        med.transmittance_to(steps, t) * sigma_s * inc.intensity * shadow * (f / (chance * pdf_t))
+    }
+}
