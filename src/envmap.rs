@@ -18,6 +18,10 @@
 //! power is a share of, is exact too: within a row the interpolation
 //! integrates to the row's mean, and between rows the linear blend times
 //! sin θ has a closed form.
+//!
+//! A second distribution, of the map less its mean luminance, serves the
+//! shadow rays that share light with a cosine strategy by MIS (MIS
+//! compensation, notes/method.md): the same lattice, other weights.
 
 use crate::film::Film;
 use crate::math::Color;
@@ -45,6 +49,14 @@ pub struct EnvMap {
     norm: f32,
     /// ∫ L dω over the sphere, per channel.
     total: Color,
+    /// The density of shadow rays whose directions a cosine strategy also
+    /// draws (MIS compensation, Karlík et al. 2019, "MIS compensation:
+    /// optimizing sampling techniques in multiple importance sampling"):
+    /// the map less its mean luminance, floored at zero, as lattice weights
+    /// with their cells and norm; the parts no brighter than the mean are
+    /// left to the other strategy. `None` where nothing is brighter than
+    /// the mean (a uniform map).
+    compensated: Option<(Vec<f32>, Discrete, f32)>,
 }
 
 /// Luminance of linear sRGB (Rec. 709 weights).
@@ -62,6 +74,22 @@ fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
     x.min(1.0 - f32::EPSILON / 2.0)
 }
 
+/// The cells between a lattice's points (`width` periodic along u, `rows`
+/// along v) by their integrals, and the cells' count over their sum;
+/// `None` where every weight is zero.
+fn lattice_cells(weights: &[f32], width: usize, rows: usize) -> (Option<Discrete>, f32) {
+    let cell = |k: usize| {
+        let (i, j) = (k % width, k / width);
+        let w = |x: usize, y: usize| weights[y * width + x % width] as f64;
+        0.25 * (w(i, j) + w(i + 1, j) + w(i, j + 1) + w(i + 1, j + 1))
+    };
+    let sum: f64 = (0..width * rows).map(cell).sum();
+    if !(sum > 0.0) {
+        return (None, 0.0);
+    }
+    (Discrete::new((0..width * rows).map(cell)), ((width * rows) as f64 / sum) as f32)
+}
+
 impl EnvMap {
     /// `image` scaled by `scale`, its frame `to_world` (orthonormal).
     pub fn new(image: &Film, scale: f32, to_world: Mat3) -> Self {
@@ -70,14 +98,7 @@ impl EnvMap {
         let rows = height.max(2) - 1;
         let sin = |y: usize| (std::f64::consts::PI * y as f64 / rows as f64).sin() as f32;
         let weights: Vec<f32> = (0..width * height).map(|i| luminance(texels[i]) * sin(i / width)).collect();
-        let cell = |i: usize, j: usize| {
-            let w = |x: usize, y: usize| weights[y * width + x % width] as f64;
-            0.25 * (w(i, j) + w(i + 1, j) + w(i, j + 1) + w(i + 1, j + 1))
-        };
-        let cells =
-            if height >= 2 { Discrete::new((0..width * rows).map(|k| cell(k % width, k / width))) } else { None };
-        let sum: f64 = if height >= 2 { (0..width * rows).map(|k| cell(k % width, k / width)).sum() } else { 0.0 };
-        let norm = if sum > 0.0 { ((width * rows) as f64 / sum) as f32 } else { 0.0 };
+        let (cells, norm) = if height >= 2 { lattice_cells(&weights, width, rows) } else { (None, 0.0) };
         let mut map = EnvMap {
             width,
             height,
@@ -88,8 +109,16 @@ impl EnvMap {
             cells,
             norm,
             total: Color::ZERO,
+            compensated: None,
         };
         map.total = map.integral();
+        if height >= 2 {
+            let mean = luminance(map.total) / (4.0 * PI);
+            let weights: Vec<f32> =
+                (0..width * height).map(|i| (luminance(map.texels[i]) - mean).max(0.0) * sin(i / width)).collect();
+            let (cells, norm) = lattice_cells(&weights, width, rows);
+            map.compensated = cells.map(|c| (weights, c, norm));
+        }
         map
     }
 
@@ -206,12 +235,6 @@ impl EnvMap {
         self.lookup(self.uv(towards))
     }
 
-    /// The weight at lattice point (x, y), x periodic.
-    #[inline]
-    fn weight(&self, x: usize, y: usize) -> f32 {
-        self.weights[y * self.width + x % self.width]
-    }
-
     /// The cell holding `uv` and the point's place in it: the cell's lower
     /// corner (texel x, row y) and (a, b) in [0, 1]^2.
     fn cell_of(&self, uv: Vec2) -> (usize, usize, f32, f32) {
@@ -229,10 +252,51 @@ impl EnvMap {
             let dir = uniform_cone(u, -1.0).normalize();
             return (dir, self.pdf(dir));
         };
+        self.sample_lattice(&self.weights, cells, self.norm, u)
+    }
+
+    /// The density of [`Self::sample`] at unit world direction `dir`.
+    pub fn pdf(&self, dir: Vec3) -> f32 {
+        if self.cells.is_none() {
+            return 1.0 / (4.0 * PI);
+        }
+        self.pdf_lattice(&self.weights, self.norm, dir)
+    }
+
+    /// Whether [`Self::sample_compensated`] differs from [`Self::sample`]:
+    /// some of the map is brighter than its mean.
+    pub fn compensates(&self) -> bool {
+        self.compensated.is_some()
+    }
+
+    /// A direction drawn from the map less its mean (the field
+    /// `compensated`), for shadow rays that share the light with a cosine
+    /// strategy; [`Self::sample`] where nothing is brighter than the mean.
+    pub fn sample_compensated(&self, u: Vec2) -> (Vec3, f32) {
+        match &self.compensated {
+            Some((weights, cells, norm)) => self.sample_lattice(weights, cells, *norm, u),
+            None => self.sample(u),
+        }
+    }
+
+    /// The density of [`Self::sample_compensated`] at `dir`: zero where
+    /// the map is no brighter than its mean.
+    pub fn pdf_compensated(&self, dir: Vec3) -> f32 {
+        match &self.compensated {
+            Some((weights, _, norm)) => self.pdf_lattice(weights, *norm, dir),
+            None => self.pdf(dir),
+        }
+    }
+
+    /// A direction drawn in proportion to the bilinear interpolation of
+    /// lattice `weights` between texel centres ([`lattice_cells`]'s
+    /// `cells` and `norm`), and its density per solid angle.
+    fn sample_lattice(&self, weights: &[f32], cells: &Discrete, norm: f32, u: Vec2) -> (Vec3, f32) {
+        let weight = |x: usize, y: usize| weights[y * self.width + x % self.width];
         let (k, rest) = cells.sample(u.x);
         let (i, j) = (k % self.width, k / self.width);
-        let (w00, w10) = (self.weight(i, j), self.weight(i + 1, j));
-        let (w01, w11) = (self.weight(i, j + 1), self.weight(i + 1, j + 1));
+        let (w00, w10) = (weight(i, j), weight(i + 1, j));
+        let (w01, w11) = (weight(i, j + 1), weight(i + 1, j + 1));
         let a = sample_linear(rest, w00 + w01, w10 + w11);
         let b = sample_linear(u.y, w00 * (1.0 - a) + w10 * a, w01 * (1.0 - a) + w11 * a);
         let uv =
@@ -242,24 +306,22 @@ impl EnvMap {
         // for rounding in the round trip through the direction).
         let bilinear = (w00 * (1.0 - a) + w10 * a) * (1.0 - b) + (w01 * (1.0 - a) + w11 * a) * b;
         let sin_theta = (uv.y * PI).sin();
-        let pdf = if sin_theta > 0.0 { bilinear * self.norm / (2.0 * PI * PI * sin_theta) } else { 0.0 };
+        let pdf = if sin_theta > 0.0 { bilinear * norm / (2.0 * PI * PI * sin_theta) } else { 0.0 };
         (dir, pdf)
     }
 
-    /// The density of [`Self::sample`] at unit world direction `dir`.
-    pub fn pdf(&self, dir: Vec3) -> f32 {
-        if self.cells.is_none() {
-            return 1.0 / (4.0 * PI);
-        }
+    /// The density of [`Self::sample_lattice`] at unit world direction `dir`.
+    fn pdf_lattice(&self, weights: &[f32], norm: f32, dir: Vec3) -> f32 {
+        let weight = |x: usize, y: usize| weights[y * self.width + x % self.width];
         let uv = self.uv(dir);
         let sin_theta = (uv.y * PI).sin();
         if !(sin_theta > 0.0) {
             return 0.0;
         }
         let (i, j, a, b) = self.cell_of(uv);
-        let top = self.weight(i, j) * (1.0 - a) + self.weight(i + 1, j) * a;
-        let bottom = self.weight(i, j + 1) * (1.0 - a) + self.weight(i + 1, j + 1) * a;
-        let density_uv = (top * (1.0 - b) + bottom * b) * self.norm;
+        let top = weight(i, j) * (1.0 - a) + weight(i + 1, j) * a;
+        let bottom = weight(i, j + 1) * (1.0 - a) + weight(i + 1, j + 1) * a;
+        let density_uv = (top * (1.0 - b) + bottom * b) * norm;
         density_uv / (2.0 * PI * PI * sin_theta)
     }
 }

@@ -258,8 +258,18 @@ fn shadow_ray_samples_follow_their_density() {
                 }
             }
             assert!(differ < 10, "{name} at {p}: {differ} of 10000 densities differ");
+            if light.compensates() {
+                // The shadow rays that share light with a cosine strategy.
+                let o = chi2.run(
+                    || light.sample_li_shared(p, n, next_2d(&mut rng)).map(|inc| inc.dir),
+                    |w| light.pdf_li_shared(p, n, w.normalize()) as f64,
+                );
+                report(name, &format!("shared shadow rays at {p:.2}"), &o, &mut failed);
+                assert!(o.pdf_mass > 0.01, "{name} at {p}: shared pdf mass {}", o.pdf_mass);
+            }
         }
     }
+    assert!(sampled.iter().any(|(_, l)| l.compensates()), "no light tests the shared shadow rays");
     assert!(failed.is_empty(), "{failed:?}");
     for (name, light) in lights.iter().filter(|(_, l)| l.is_delta()) {
         // A point each light reaches: along a spot's or a projector's axis.

@@ -374,3 +374,76 @@ fn rough_glass_in_a_furnace_sees_the_sky_through_itself() {
     assert!((0.985..1.01).contains(&with), "with MIS {with}");
     assert!(without < 0.8, "shadow rays alone {without}");
 }
+
+/// Under an environment map with a sun, a diffuse floor, a diffuse ball
+/// and a glass ball (which final gathering aims at).
+fn diffuse_under_a_map() -> Scene {
+    let materials = vec![
+        Material::Lambertian { rho: Color::new(0.7, 0.6, 0.5) },
+        Material::Lambertian { rho: Color::splat(0.5) },
+        Material::glass(1.5),
+    ];
+    let mut prims = vec![
+        Prim { shape: Shape::Sphere(Sphere { center: Vec3::new(0.0, 0.6, 0.0), radius: 0.5 }), material: 1, object: 0 },
+        Prim {
+            shape: Shape::Sphere(Sphere { center: Vec3::new(0.0, -0.6, 0.0), radius: 0.5 }),
+            material: 2,
+            object: 1,
+        },
+    ];
+    let (a, b, c, d) = (
+        Vec3::new(-3.0, -3.0, -0.5),
+        Vec3::new(3.0, -3.0, -0.5),
+        Vec3::new(3.0, 3.0, -0.5),
+        Vec3::new(-3.0, 3.0, -0.5),
+    );
+    for t in [Triangle::new(a, b, c), Triangle::new(a, c, d)] {
+        prims.push(Prim { shape: Shape::Triangle(t), material: 0, object: 2 });
+    }
+    let camera = Camera::from_corners(
+        Vec3::new(-3.0, 0.0, 0.5),
+        [
+            Vec3::new(-2.0, -0.6, -0.4),
+            Vec3::new(-2.0, 0.6, -0.4),
+            Vec3::new(-2.0, 0.6, 0.8),
+            Vec3::new(-2.0, -0.6, 0.8),
+        ],
+        16,
+        16,
+    );
+    // The map's +y is up here: turned onto the scene's +z.
+    let turn = Mat3::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    let map = EnvMap::new(&sky_map().image().0, 1.0, turn);
+    Scene::from_parts(SceneParts {
+        prims,
+        shading_normals: Vec::new(),
+        materials,
+        lights: vec![Light::Envmap(Environment::new(Arc::new(map)))],
+        ambient: Color::ZERO,
+        camera,
+        one_sided: Vec::new(),
+        paths: PathLimits::default(),
+        texturing: Default::default(),
+        media: Default::default(),
+    })
+}
+
+/// A diffuse point shares a map's direct light between shadow rays drawn
+/// from the map less its mean and its gather rays (MIS compensation): the
+/// same mean as shadow rays alone, drawn from the whole map, and less noise
+/// where the sun is hidden.
+#[test]
+fn diffuse_points_share_a_maps_light_with_their_gather_rays() {
+    let scene = diffuse_under_a_map();
+    let settings = Settings { photons: 40_000, caustic_photons: 40_000, ..Settings::default() };
+    let est = Estimates::progressive(&scene, &settings, 0);
+    let maps = photon_pass(&scene, &settings, 0, est, Mode::Quiet, &mut Stats::default());
+    let mut integrator = photon_integrator(&scene, &settings, &maps, est);
+    assert!(integrator.settings.gather_rays > 0 && integrator.settings.mis);
+    integrator.settings.shadow_rays = 2;
+    let shared = blocks(&integrator, &scene, 16, 400, 31);
+    integrator.settings.mis = false;
+    integrator.settings.shadow_rays = 32;
+    let plain = blocks(&integrator, &scene, 16, 400, 32);
+    assert_agree("diffuse under a map", &shared, &plain);
+}

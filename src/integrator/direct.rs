@@ -92,16 +92,55 @@ pub fn direct_light_mis(
     both_sides: bool,
     ctx: &mut Context,
 ) -> Color {
+    direct_light_weighted(scene, hit, n, bsdf, count, skip, both_sides, false, ctx)
+}
+
+/// [`direct_light_mis`] where the continuation's strategy draws every
+/// direction of the hemisphere (final gathering's cosine rays): the lights
+/// draw their shadow rays by `Source::sample_li_shared`, an environment
+/// map from its parts brighter than its mean (MIS compensation).
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+pub fn direct_light_shared(
+    scene: &Scene,
+    hit: &Hit,
+    n: Vec3,
+    bsdf: impl Fn(Vec3) -> MisBsdf,
+    count: u32,
+    skip: bool,
+    both_sides: bool,
+    ctx: &mut Context,
+) -> Color {
+    direct_light_weighted(scene, hit, n, bsdf, count, skip, both_sides, true, ctx)
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn direct_light_weighted(
+    scene: &Scene,
+    hit: &Hit,
+    n: Vec3,
+    bsdf: impl Fn(Vec3) -> MisBsdf,
+    count: u32,
+    skip: bool,
+    both_sides: bool,
+    shared: bool,
+    ctx: &mut Context,
+) -> Color {
     each_light(scene, hit, n, count, skip, ctx, |light, count, share, ctx| {
         let mut sum = Color::ZERO;
         for s in 0..count {
             let u = stratified_2d(s, count, next_2d(ctx.rng));
-            let Some(inc) = light.sample_li(hit.point, n, u) else { continue };
+            let sample =
+                if shared { light.sample_li_shared(hit.point, n, u) } else { light.sample_li(hit.point, n, u) };
+            let Some(inc) = sample else { continue };
             let cos_x = n.dot(inc.dir);
             if facing(cos_x, both_sides) && reaches(hit, n, inc.dir, cos_x > 0.0) && unshadowed(scene, hit, &inc, ctx) {
                 let f = bsdf(inc.dir);
                 let w = if light.is_delta() {
                     1.0
+                } else if shared {
+                    power_heuristic(share, light.pdf_li_shared(hit.point, n, inc.dir), 1.0, f.pdf)
                 } else {
                     power_heuristic(share, light.pdf_li_of(hit.point, n, &inc), 1.0, f.pdf)
                 };

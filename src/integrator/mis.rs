@@ -51,6 +51,9 @@ pub struct BsdfSample {
     pub pdf: f32,
     /// Shadow rays per (non-delta) light at the vertex.
     pub shadow_rays: u32,
+    /// Whether they were drawn by `Source::sample_li_shared`
+    /// ([`super::direct_light_shared`]).
+    pub compensated: bool,
 }
 
 impl BsdfSample {
@@ -85,7 +88,12 @@ impl BsdfSample {
             let light = &scene.lights[index];
             let le = light.radiance_from_infinity(dir);
             if le != Color::ZERO {
-                sum += le * self.weight(scene, index, light.pdf_li(self.point, self.normal, dir));
+                let pdf = if self.compensated {
+                    light.pdf_li_shared(self.point, self.normal, dir)
+                } else {
+                    light.pdf_li(self.point, self.normal, dir)
+                };
+                sum += le * self.weight(scene, index, pdf);
             }
         }
         sum

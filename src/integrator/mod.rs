@@ -20,7 +20,9 @@ pub mod volpath;
 pub mod volphoton;
 pub mod whitted;
 
-pub use direct::{direct_irradiance, direct_light, direct_light_mis, direct_light_one_at_a_time, MisBsdf};
+pub use direct::{
+    direct_irradiance, direct_light, direct_light_mis, direct_light_one_at_a_time, direct_light_shared, MisBsdf,
+};
 
 use crate::math::{Color, Ray};
 use crate::sampling::Rng;

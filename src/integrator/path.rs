@@ -123,6 +123,7 @@ impl Integrator for PathIntegrator<'_> {
                     normal: n,
                     pdf: material.pdf(wo, s.wi, entering),
                     shadow_rays: self.shadow_rays,
+                    compensated: false,
                 });
                 s
             };

@@ -21,7 +21,7 @@
 
 use super::aim::{Aim, AimTargets};
 use super::mis::BsdfSample;
-use super::{direct_light, direct_light_mis, Context, Integrator, MisBsdf, Part};
+use super::{direct_light, direct_light_mis, direct_light_shared, Context, Integrator, MisBsdf, Part};
 use crate::material::{Branch, Branches, Glossy, Lobe, Material, Transport};
 use crate::math::{Color, Frame, Ray};
 use crate::photon::aims::Target;
@@ -46,6 +46,16 @@ const MAX_SPECULAR_DEPTH: u32 = 24;
 /// this (cosine) of its own: the same plane, or a curved surface's nearby
 /// point.
 const REUSE_NORMAL_COSINE: f32 = 0.999;
+
+/// The density of all of a point's gather rays together towards a
+/// direction of cosine `cos`: `nc` cosine rays and `na` aimed ones, whose
+/// density `aimed_pdf` gives.
+fn gather_density(cos: f32, nc: u32, na: u32, aimed_pdf: impl FnOnce() -> f32) -> f32 {
+    if !(cos > 0.0) {
+        return 0.0;
+    }
+    nc as f32 * cos / PI + if na > 0 { na as f32 * aimed_pdf() } else { 0.0 }
+}
 
 /// The fractional part of the golden ratio: a sequence stepping by it
 /// fills [0, 1) evenly at every length.
@@ -276,6 +286,18 @@ impl<'a> PhotonIntegrator<'a> {
         // noisy than a diffuse point's indirect light.
         let glossy_rays = if self.scene.paths.max_depth.is_some() { 1 } else { s.gather_rays.max(1) };
         let rays = glossy_rays as f32;
+        // A diffuse point's direct light is shared with its gather rays by
+        // MIS where a light at infinity leaves its dim parts to them (an
+        // environment map brighter than its mean somewhere) and they are
+        // traced: shadow rays drawn by the map's brightness alone are
+        // wasted on a sun the point does not see (notes/method.md).
+        let shares_with_gathering = mis.is_none()
+            && s.mis
+            && self.scene.lights_at_infinity().iter().any(|&i| self.scene.lights[i as usize].compensates())
+            && self.scene.paths.max_depth.is_none()
+            && material.diffuse_rho().is_some()
+            && s.gather_rays > 0
+            && !self.cache.is_empty();
         let direct = match mis {
             Some(g) => {
                 let bsdf = |w: glam::Vec3| {
@@ -285,6 +307,20 @@ impl<'a> PhotonIntegrator<'a> {
                     MisBsdf { alone, shared, pdf: rays * g.pdf(wo, wi, entering) }
                 };
                 direct_light_mis(self.scene, hit, n, bsdf, s.shadow_rays, s.skip, both, sh.ctx)
+            }
+            None if shares_with_gathering => {
+                // Light from everywhere is shared with the gather rays (all
+                // of them together one strategy; their weights in
+                // `indirect`): the shadow rays go to the map's parts
+                // brighter than its mean, the gather rays find the rest.
+                let (nc, na) = self.gather_split(hit, n, sh);
+                let aims = &sh.thread.aims;
+                let bsdf = |w: glam::Vec3| MisBsdf {
+                    alone: Color::ZERO,
+                    shared: material.eval(wo, frame.to_local(w), entering, Transport::Radiance),
+                    pdf: gather_density(w.dot(n), nc, na, || aims.pdf(w)),
+                };
+                direct_light_shared(self.scene, hit, n, bsdf, s.shadow_rays, s.skip, both, sh.ctx)
             }
             None => {
                 let brdf = |w: glam::Vec3| material.eval(wo, frame.to_local(w), entering, Transport::Radiance);
@@ -306,7 +342,7 @@ impl<'a> PhotonIntegrator<'a> {
         if material.diffuse_rho().is_some() {
             let rho = material.diffuse_albedo(wo);
             caustic = self.caustic(hit, n, rho, sh);
-            indirect = self.indirect(hit, n, rho, w, sh);
+            indirect = self.indirect(hit, n, rho, w, shares_with_gathering, sh);
         }
         if let Some(g) = material.glossy() {
             // Gather rays from the glossy lobe: indirect light it reflects,
@@ -331,7 +367,7 @@ impl<'a> PhotonIntegrator<'a> {
     /// What light a glossy lobe's gather ray meets needs for its MIS
     /// weight.
     fn bsdf_sample(&self, hit: &Hit, n: glam::Vec3, pdf: f32) -> BsdfSample {
-        BsdfSample { point: hit.point, normal: n, pdf, shadow_rays: self.settings.shadow_rays }
+        BsdfSample { point: hit.point, normal: n, pdf, shadow_rays: self.settings.shadow_rays, compensated: false }
     }
 
     /// The light a sample of the glossy lobe meets straight from `hit`,
@@ -394,14 +430,14 @@ impl<'a> PhotonIntegrator<'a> {
     ///
     /// Where the point sees a mirror or glass object or a bright spot, some
     /// of the rays are aimed at them ([`super::aim`]).
-    fn indirect(&self, hit: &Hit, n: glam::Vec3, rho: Color, w: Color, sh: &mut Shade<'_, '_, 'a>) -> Color {
+    /// With `mis`, the rays also bring the direct light from infinity
+    /// they meet, weighted against the shadow rays'.
+    fn indirect(&self, hit: &Hit, n: glam::Vec3, rho: Color, w: Color, mis: bool, sh: &mut Shade<'_, '_, 'a>) -> Color {
         let count = self.settings.gather_rays;
         if count == 0 || self.cache.is_empty() {
             return Color::ZERO;
         }
-        let aims = self.settings.aimed_gather_rays.min(count - 1);
-        let aimed = if aims > 0 && sh.thread.aims.prepare(self.aims(hit.point), hit.point, n) { aims } else { 0 };
-        let cosine = count - aimed;
+        let (cosine, aimed) = self.gather_split(hit, n, sh);
         let frame = Frame::from_normal(n);
         // Each ray, cosine or aimed, weighed by the balance heuristic:
         // f cos / (cosine p_cos + aimed p_aim), f = rho / pi, p_cos = cos / pi;
@@ -426,10 +462,24 @@ impl<'a> PhotonIntegrator<'a> {
                 continue;
             }
             let c = if aimed == 0 { 1.0 / nc } else { cos / (nc * cos + na * PI * sh.thread.aims.pdf(dir)) };
+            let sample = mis.then(|| {
+                let aims = &sh.thread.aims;
+                let pdf = gather_density(cos, cosine, aimed, || aims.pdf(dir));
+                BsdfSample { compensated: true, ..self.bsdf_sample(hit, n, pdf) }
+            });
             let (ray, dep) = hit.spawn(dir);
-            sum += c * self.gather(ray, dep, Lobe::Diffuse, None, w * rho * c, sh);
+            sum += c * self.gather(ray, dep, Lobe::Diffuse, sample, w * rho * c, sh);
         }
         rho * sum
+    }
+
+    /// How many of the gather rays at `hit` are cosine and how many aimed
+    /// (the aims prepared for it).
+    fn gather_split(&self, hit: &Hit, n: glam::Vec3, sh: &mut Shade<'_, '_, 'a>) -> (u32, u32) {
+        let count = self.settings.gather_rays;
+        let aims = self.settings.aimed_gather_rays.min(count.saturating_sub(1));
+        let aimed = if aims > 0 && sh.thread.aims.prepare(self.aims(hit.point), hit.point, n) { aims } else { 0 };
+        (count - aimed, aimed)
     }
 
     /// What final gathering aims at: the mirror and glass objects' bounding
@@ -558,6 +608,7 @@ impl<'a> PhotonIntegrator<'a> {
                         normal: frame.n,
                         pdf,
                         shadow_rays: self.settings.shadow_rays,
+                        compensated: false,
                     });
                 }
                 frame.to_world(wi).normalize()

@@ -39,6 +39,21 @@ impl Source for Environment {
         self.map.pdf(dir)
     }
 
+    fn compensates(&self) -> bool {
+        self.map.compensates()
+    }
+
+    /// From the map less its mean: the sun, not the sky, which the cosine
+    /// strategy sharing the light finds better.
+    fn sample_li_shared(&self, _p: Vertex, _n: Vec3, u: Vec2) -> Option<Incident> {
+        let (dir, pdf) = self.map.sample_compensated(u);
+        (pdf > 0.0).then(|| Incident { dir, target: None, intensity: self.map.eval(dir) / pdf, prim: None })
+    }
+
+    fn pdf_li_shared(&self, _p: Vertex, _n: Vec3, dir: Vec3) -> f32 {
+        self.map.pdf_compensated(dir)
+    }
+
     /// A direction drawn from the map, a start on the box's shadow across
     /// it: the photon carries L A / pdf, A the shadow's area, as its
     /// share of the power the map sends into the box, per channel.

@@ -119,6 +119,25 @@ pub trait Source {
         self.pdf_li(p, n, inc.dir)
     }
 
+    /// Whether the light draws shadow rays differently where a cosine
+    /// strategy shares its light by MIS ([`Self::sample_li_shared`]).
+    fn compensates(&self) -> bool {
+        false
+    }
+
+    /// [`Self::sample_li`] for shadow rays whose directions a cosine
+    /// strategy at `p` also draws (MIS): a light from everywhere may leave
+    /// its dim parts to that strategy (MIS compensation). The same as
+    /// `sample_li` unless [`Self::compensates`].
+    fn sample_li_shared(&self, p: Vertex, n: Vec3, u: Vec2) -> Option<Incident> {
+        self.sample_li(p, n, u)
+    }
+
+    /// The density of [`Self::sample_li_shared`].
+    fn pdf_li_shared(&self, p: Vertex, n: Vec3, dir: Vec3) -> f32 {
+        self.pdf_li(p, n, dir)
+    }
+
     /// A photon's start with the light's natural distribution (area lights:
     /// uniform position, cosine direction; point lights: uniform direction;
     /// light from infinity: uniform on a disk across it that covers the
@@ -258,6 +277,21 @@ impl Light {
     #[inline]
     pub fn pdf_li_of(&self, p: Vertex, n: Vec3, inc: &Incident) -> f32 {
         each!(self, l => l.pdf_li_of(p, n, inc))
+    }
+
+    /// See [`Source::compensates`].
+    pub fn compensates(&self) -> bool {
+        each!(self, l => l.compensates())
+    }
+
+    /// See [`Source::sample_li_shared`].
+    pub fn sample_li_shared(&self, p: Vertex, n: Vec3, u: Vec2) -> Option<Incident> {
+        each!(self, l => l.sample_li_shared(p, n, u))
+    }
+
+    /// See [`Source::pdf_li_shared`].
+    pub fn pdf_li_shared(&self, p: Vertex, n: Vec3, dir: Vec3) -> f32 {
+        each!(self, l => l.pdf_li_shared(p, n, dir))
     }
 
     /// See [`Source::sample_le`].
