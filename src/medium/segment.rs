@@ -17,7 +17,18 @@ use rand::RngExt;
 pub struct Steps {
     /// (distance, transmittance from 0 to just past it), increasing.
     steps: Vec<(f32, Color)>,
+    /// A homogeneous medium's transmittance at evenly spaced distances
+    /// `spacing` apart (empty: computed exactly), read by linear interpolation: the beam
+    /// estimate asks it at each of hundreds of photons per segment, where
+    /// three exponentials each were most of its arithmetic. (Between
+    /// entries exp(-σ t) is off its chord by at most (σ Δt)² / 8 of its
+    /// value: below 2·10⁻⁴ with σ Δt ≤ 1/25.)
+    table: Vec<Color>,
+    spacing: f32,
 }
+
+/// The most intervals of a homogeneous medium's transmittance table.
+const MAX_TABLE: usize = 1024;
 
 impl Medium {
     /// Tracks the transmittance along `ray` over [0, `t_max`] into
@@ -26,7 +37,30 @@ impl Medium {
     pub fn track(&self, ray: &Ray, t_max: f32, rng: &mut crate::sampling::Rng, steps: &mut Steps) -> Color {
         steps.steps.clear();
         match self.kind {
-            Kind::Homogeneous { sigma_t } => exp_neg(sigma_t, t_max),
+            Kind::Homogeneous { sigma_t } => {
+                // The table reaches where the transmittance is below e⁻¹⁰
+                // in every channel, or the segment's end; beyond, it is
+                // computed.
+                let sigma_min = sigma_t.min_element();
+                let reach = if sigma_min > 0.0 { t_max.min(10.0 / sigma_min) } else { t_max };
+                // Entries σ Δt ≤ 1/25 apart, each the one before times
+                // the step's transmittance (rounding grows by one ulp an
+                // entry, at most 1024 of them).
+                steps.table.clear();
+                let n = (sigma_t.max_element() * reach / 0.04).ceil();
+                if reach.is_finite() && reach > 0.0 && n <= MAX_TABLE as f32 {
+                    let n = (n as usize).max(1);
+                    steps.spacing = reach / n as f32;
+                    let step = exp_neg(sigma_t, steps.spacing);
+                    let mut tr = Color::ONE;
+                    steps.table.push(tr);
+                    for _ in 0..n {
+                        tr *= step;
+                        steps.table.push(tr);
+                    }
+                }
+                exp_neg(sigma_t, t_max)
+            }
             Kind::Heterogeneous { majorant, bbox } => {
                 let Some((t0, t1)) = bbox.clip(ray, t_max) else { return Color::ONE };
                 if !(majorant > 0.0) {
@@ -55,7 +89,19 @@ impl Medium {
     #[inline]
     pub fn transmittance_to(&self, steps: &Steps, t: f32) -> Color {
         match self.kind {
-            Kind::Homogeneous { sigma_t } => exp_neg(sigma_t, t),
+            Kind::Homogeneous { sigma_t } => {
+                if steps.table.is_empty() {
+                    return exp_neg(sigma_t, t);
+                }
+                let last = steps.table.len() - 1;
+                let x = (t / steps.spacing).max(0.0);
+                if !(x < last as f32) {
+                    return exp_neg(sigma_t, t);
+                }
+                let i = (x as usize).min(last - 1);
+                let f = x - i as f32;
+                steps.table[i] + (steps.table[i + 1] - steps.table[i]) * f
+            }
             Kind::Heterogeneous { .. } => match steps.steps.partition_point(|s| s.0 <= t) {
                 0 => Color::ONE,
                 i => steps.steps[i - 1].1,
@@ -116,6 +162,31 @@ mod tests {
     use crate::medium::{Phase, Volume};
     use crate::sampling::{stream, Domain};
     use glam::{Affine3A, Vec3};
+
+    /// The transmittance read from a homogeneous segment's table is
+    /// Beer–Lambert's within 0.05%, short
+    /// segments and long, grey and chromatic.
+    #[test]
+    fn a_tracked_homogeneous_segment_reads_beer_lambert() {
+        let albedo = Volume::Constant { value: Color::ONE, to_world: Affine3A::IDENTITY };
+        let mut rng = stream(5, Domain::Camera, 0);
+        let ray = Ray::new(Vec3::ZERO, Vec3::X);
+        for sigma in [Color::splat(0.25), Color::new(0.05, 1.0, 4.0)] {
+            let m = Medium::homogeneous(sigma, albedo.clone(), 1.0, Phase::Isotropic).unwrap();
+            for t_max in [0.01f32, 1.0, 7.0, 40.0, f32::INFINITY] {
+                let mut steps = Steps::default();
+                m.track(&ray, t_max, &mut rng, &mut steps);
+                for i in 0..=1000 {
+                    let t = i as f32 / 1000.0 * t_max.min(60.0);
+                    let (got, want) = (m.transmittance_to(&steps, t), exp_neg(sigma, t));
+                    for c in 0..3 {
+                        let ok = (got[c] - want[c]).abs() <= 5e-4 * want[c];
+                        assert!(ok, "σ {sigma}, segment {t_max}, t {t}: {got} vs {want}");
+                    }
+                }
+            }
+        }
+    }
 
     /// The distances drawn along a segment integrate a function by their
     /// density: ∫₀^L exp(-t) dt estimated with a homogeneous medium's
