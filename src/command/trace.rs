@@ -42,6 +42,7 @@ pub fn run(cli: Request) -> Result<(), Error> {
             cli.scene.display()
         )));
     }
+    refuse_unreadable(&file)?;
     let id =
         SceneId::from_files(&cli.scene, &file.meshes).map_err(|e| Error::Io { path: cli.scene.clone(), source: e })?;
     for input in &id.inputs {
@@ -108,6 +109,39 @@ pub fn run(cli: Request) -> Result<(), Error> {
         eprintln!("  camera pass  {:>8.3} s", render_time.as_secs_f64());
         eprintln!("  write        {:>8.3} s  {}", write_time.as_secs_f64(), cli.out.display());
         eprintln!("  total        {:>8.3} s", start.elapsed().as_secs_f64());
+    }
+    Ok(())
+}
+
+/// Refuses, at its place in the file, the first material on a shape that
+/// the course's tracer cannot render (it reads Phong, Lambertian as Phong,
+/// and follows the perfect mirrors and refractions): a rough, coated,
+/// principled, blended, masked or textured one would be drawn as something
+/// else without a word.
+fn refuse_unreadable(file: &crate::scene::file::SceneFile) -> Result<(), Error> {
+    let parts = &file.parts;
+    let texturing = &parts.texturing;
+    for p in &parts.prims {
+        let m = p.material as usize;
+        let material = &parts.materials[m];
+        let readable = material.course_phong().is_some()
+            || material.is_specular()
+            || matches!(material, crate::material::Material::Masked(k) if k.opacity == 0.0);
+        let textured =
+            matches!(texturing.materials.get(m), Some(Some(_))) || matches!(texturing.perturb.get(m), Some(Some(_)));
+        if readable && !textured {
+            continue;
+        }
+        let place = file.origins.materials.get(m).cloned().unwrap_or_default();
+        return Err(Error::Invalid(
+            file.origins
+                .error(
+                    &place,
+                    "the Whitted tracer renders lambertian, phong, mirror, glass, conductor, thindielectric and null \
+                     materials without textures; this material only photonmap renders",
+                )
+                .to_string(),
+        ));
     }
     Ok(())
 }

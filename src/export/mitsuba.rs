@@ -36,12 +36,12 @@ use super::ply::PlyMesh;
 use crate::camera::Camera;
 use crate::light::{AreaLight, Emitting, Light, MitsubaEmitter, MitsubaParam};
 use crate::material::Material;
-use crate::math::{Color, Frame};
+use crate::math::Color;
 use crate::scene::file::{Origins, Place};
 use crate::scene::procedural::icosphere;
 use crate::scene::SceneParts;
 use crate::shape::{Ellipsoid, Shape, FLAT};
-use glam::{Affine3A, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 use std::fmt::Write;
 
 /// An exported scene: the XML text, the files it names (meshes and
@@ -127,9 +127,30 @@ pub fn to_mitsuba(
             used[*m as usize] = true;
         }
     }
+    // A blend's materials are written too, wherever they are named.
+    let mut changed = true;
+    while changed {
+        changed = false;
+        for m in 0..used.len() {
+            for k in super::mitsuba_recipe::parts_of(parts, m).filter(|_| used[m]).into_iter().flatten() {
+                if !used[k as usize] {
+                    used[k as usize] = true;
+                    changed = true;
+                }
+            }
+        }
+    }
     let mut bsdfs = String::new();
+    let mut copied = Vec::new();
     for (i, m) in parts.materials.iter().enumerate().filter(|(i, _)| used[*i]) {
-        let xml = bsdf(m, &format!("material{i}")).map_err(|msg| refuse(place(&|o| o.materials.get(i)), msg))?;
+        let id = format!("material{i}");
+        let xml = if super::mitsuba_recipe::needed(parts, i) {
+            let mut files = super::mitsuba_recipe::Files { dir: mesh_dir, files: &mut out.meshes, copied: &mut copied };
+            super::mitsuba_recipe::element(parts, i, &id, &mut files, &bsdf)
+        } else {
+            bsdf(m, &id)
+        };
+        let xml = xml.map_err(|msg| refuse(place(&|o| o.materials.get(i)), msg))?;
         bsdfs += &xml;
         if let Material::Glass { absorption, .. } = m {
             if *absorption != Color::ZERO {
@@ -163,20 +184,30 @@ pub fn to_mitsuba(
         let media = interface(&parts.media.prims, i);
         if let Shape::Triangle(t) = p.shape {
             let smooth = t.shading != FLAT;
+            // Coordinates of its own (a mesh's without read back as its
+            // barycentrics).
+            let uv = match parts.texturing.surfaces.get(i) {
+                Some(crate::texture::SurfaceUv::Triangle(uv)) if *uv != [Vec2::ZERO, Vec2::X, Vec2::Y] => Some(*uv),
+                _ => None,
+            };
             let same = run_media == media
-                && run
-                    .as_ref()
-                    .is_some_and(|(o, m, mesh)| *o == p.object && *m == p.material && mesh.is_smooth() == smooth);
+                && run.as_ref().is_some_and(|(o, m, mesh)| {
+                    *o == p.object
+                        && *m == p.material
+                        && mesh.is_smooth() == smooth
+                        && mesh.is_textured() == uv.is_some()
+                });
             if !same {
                 if let Some((_, m, mesh)) = run.take() {
                     shapes += &out.mesh(mesh, &refs(m, run_media)?, "");
                 }
-                run = Some((p.object, p.material, PlyMesh::new(smooth)));
+                let mesh = if uv.is_some() { PlyMesh::textured(smooth) } else { PlyMesh::new(smooth) };
+                run = Some((p.object, p.material, mesh));
                 run_media = media;
             }
             let normals = if smooth { parts.shading_normals[t.shading as usize] } else { [t.normal; 3] };
             if let Some((_, _, mesh)) = run.as_mut() {
-                mesh.push([t.v0, t.v1, t.v2].map(at), normals);
+                mesh.push_uv([t.v0, t.v1, t.v2].map(at), normals, uv.unwrap_or_default());
             }
             continue;
         }
@@ -439,9 +470,7 @@ fn bsdf(m: &Material, id: &str) -> Result<String, String> {
 
 /// The transform taking Mitsuba's unit disk (normal +z) to a disk.
 fn disk_transform(center: Vec3, normal: Vec3, radius: f32) -> String {
-    let f = Frame::from_normal(normal);
-    let m = Affine3A::from_cols((f.s * radius).into(), (f.t * radius).into(), (f.n * radius).into(), center.into());
-    matrix(&m)
+    matrix(&crate::shape::Disk { center, normal, radius }.to_world())
 }
 
 pub(super) fn matrix(m: &Affine3A) -> String {

@@ -4,5 +4,6 @@
 pub mod mitsuba;
 mod mitsuba_bsdf;
 mod mitsuba_medium;
+mod mitsuba_recipe;
 mod mitsuba_sensor;
 mod ply;

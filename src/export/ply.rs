@@ -1,8 +1,9 @@
 //! Triangle meshes as binary PLY (little-endian), the format Mitsuba reads
 //! fastest: vertices shared where position and normal are bit-identical,
-//! vertex normals written only for smooth meshes.
+//! vertex normals written only for smooth meshes, texture coordinates only
+//! for meshes that have their own.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::collections::HashMap;
 
 /// A mesh being collected: its triangles, each with its vertex normals if
@@ -11,15 +12,26 @@ use std::collections::HashMap;
 pub struct PlyMesh {
     positions: Vec<Vec3>,
     normals: Vec<Vec3>,
+    uvs: Vec<Vec2>,
     faces: Vec<[u32; 3]>,
-    index: HashMap<[u32; 6], u32>,
+    index: HashMap<[u32; 8], u32>,
     smooth: bool,
+    textured: bool,
 }
 
 impl PlyMesh {
     /// An empty mesh, with vertex normals (`smooth`) or without.
     pub fn new(smooth: bool) -> Self {
         PlyMesh { smooth, ..Default::default() }
+    }
+
+    /// An empty mesh whose vertices carry texture coordinates.
+    pub fn textured(smooth: bool) -> Self {
+        PlyMesh { smooth, textured: true, ..Default::default() }
+    }
+
+    pub fn is_textured(&self) -> bool {
+        self.textured
     }
 
     pub fn is_smooth(&self) -> bool {
@@ -32,13 +44,21 @@ impl PlyMesh {
 
     /// Adds a triangle wound as given; `normals` is used when the mesh is smooth.
     pub fn push(&mut self, vertices: [Vec3; 3], normals: [Vec3; 3]) {
+        self.push_uv(vertices, normals, [Vec2::ZERO; 3]);
+    }
+
+    /// Adds a triangle with texture coordinates (used where the mesh is
+    /// textured).
+    pub fn push_uv(&mut self, vertices: [Vec3; 3], normals: [Vec3; 3], uvs: [Vec2; 3]) {
         let face = [0, 1, 2].map(|k| {
             let n = if self.smooth { normals[k] } else { Vec3::ZERO };
+            let t = if self.textured { uvs[k] } else { Vec2::ZERO };
             let p = vertices[k];
-            let key = [p.x, p.y, p.z, n.x, n.y, n.z].map(f32::to_bits);
+            let key = [p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y].map(f32::to_bits);
             *self.index.entry(key).or_insert_with(|| {
                 self.positions.push(p);
                 self.normals.push(n);
+                self.uvs.push(t);
                 self.positions.len() as u32 - 1
             })
         });
@@ -55,16 +75,24 @@ impl PlyMesh {
         if self.smooth {
             header += "property float nx\nproperty float ny\nproperty float nz\n";
         }
+        if self.textured {
+            header += "property float u\nproperty float v\n";
+        }
         header += &format!("element face {}\nproperty list uchar int vertex_indices\nend_header\n", self.faces.len());
-        let per_vertex = if self.smooth { 24 } else { 12 };
+        let per_vertex = 12 + if self.smooth { 12 } else { 0 } + if self.textured { 8 } else { 0 };
         let mut out = Vec::with_capacity(header.len() + self.positions.len() * per_vertex + self.faces.len() * 13);
         out.extend_from_slice(header.as_bytes());
-        for (p, n) in self.positions.iter().zip(&self.normals) {
+        for ((p, n), t) in self.positions.iter().zip(&self.normals).zip(&self.uvs) {
             for v in p.to_array() {
                 out.extend_from_slice(&v.to_le_bytes());
             }
             if self.smooth {
                 for v in n.to_array() {
+                    out.extend_from_slice(&v.to_le_bytes());
+                }
+            }
+            if self.textured {
+                for v in t.to_array() {
                     out.extend_from_slice(&v.to_le_bytes());
                 }
             }

@@ -48,6 +48,7 @@ mod glossy;
 mod mask;
 pub mod microfacet;
 mod mitsuba;
+pub mod params;
 mod phong;
 mod plastic;
 mod principled;

@@ -154,7 +154,29 @@ pub struct ThinRecipe {
 }
 
 impl PrincipledRecipe {
-    fn params(&self) -> [Param; 11] {
+    /// The recipe of the parameters in the order of
+    /// [`super::params::PRINCIPLED`].
+    pub fn from_params(p: [Param; 11], eta: f32, rates: Rates) -> Self {
+        let [base_color, roughness, anisotropic, metallic, spec_trans, spec_tint, sheen, sheen_tint, flatness, clearcoat, clearcoat_gloss] =
+            p;
+        PrincipledRecipe {
+            base_color,
+            roughness,
+            anisotropic,
+            metallic,
+            spec_trans,
+            spec_tint,
+            sheen,
+            sheen_tint,
+            flatness,
+            clearcoat,
+            clearcoat_gloss,
+            eta,
+            rates,
+        }
+    }
+
+    pub fn params(&self) -> [Param; 11] {
         [
             self.base_color,
             self.roughness,
@@ -172,7 +194,27 @@ impl PrincipledRecipe {
 }
 
 impl ThinRecipe {
-    fn params(&self) -> [Param; 10] {
+    /// The recipe of the parameters in the order of
+    /// [`super::params::PRINCIPLED_THIN`].
+    pub fn from_params(p: [Param; 10], rates: Rates) -> Self {
+        let [base_color, roughness, anisotropic, spec_trans, eta, spec_tint, sheen, sheen_tint, flatness, diff_trans] =
+            p;
+        ThinRecipe {
+            base_color,
+            roughness,
+            anisotropic,
+            spec_trans,
+            eta,
+            spec_tint,
+            sheen,
+            sheen_tint,
+            flatness,
+            diff_trans,
+            rates,
+        }
+    }
+
+    pub fn params(&self) -> [Param; 10] {
         [
             self.base_color,
             self.roughness,

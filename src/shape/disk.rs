@@ -14,6 +14,14 @@ pub struct Disk {
 }
 
 impl Disk {
+    /// The transform taking Mitsuba's unit disk (normal +z) to this one
+    /// (its tangents from the normal's frame).
+    pub fn to_world(&self) -> glam::Affine3A {
+        let f = crate::math::Frame::from_normal(self.normal);
+        let r = self.radius;
+        glam::Affine3A::from_cols((f.s * r).into(), (f.t * r).into(), (f.n * r).into(), self.center.into())
+    }
+
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
         self.distance(ray, t_max).map(|t| self.record(ray, t))
     }

@@ -53,6 +53,9 @@ pub struct Bitmap {
     data: Vec<f32>,
     pub filter: Filter,
     pub wrap: Wrap,
+    /// The file it was read from and whether read `raw` (what the Mitsuba
+    /// export refers to); `None` for an image made in memory.
+    pub source: Option<(std::path::PathBuf, bool)>,
 }
 
 impl Bitmap {
@@ -67,12 +70,18 @@ impl Bitmap {
         if data.iter().any(|v| !v.is_finite()) {
             return Err("the image holds non-finite values".into());
         }
-        Ok(Bitmap { width, height, channels, data, filter: Filter::Bilinear, wrap: Wrap::Repeat })
+        Ok(Bitmap { width, height, channels, data, filter: Filter::Bilinear, wrap: Wrap::Repeat, source: None })
     }
 
     /// Reads PNG, JPEG, BMP, PNM, Radiance HDR or OpenEXR, by the file's
     /// extension; `raw` leaves 8- and 16-bit values undecoded.
     pub fn load(path: &Path, raw: bool) -> Result<Self, String> {
+        let mut image = Self::decode(path, raw)?;
+        image.source = Some((path.to_path_buf(), raw));
+        Ok(image)
+    }
+
+    fn decode(path: &Path, raw: bool) -> Result<Self, String> {
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
         if ext == "exr" {
             let film = crate::output::read_exr(path).map_err(|e| e.to_string())?;
@@ -99,6 +108,21 @@ impl Bitmap {
             image.to_rgb32f().into_raw().into_iter().map(decode).collect()
         };
         Bitmap::new(width, height, if grey { 1 } else { 3 }, data)
+    }
+
+    pub fn filter_name(&self) -> &'static str {
+        match self.filter {
+            Filter::Bilinear => "bilinear",
+            Filter::Nearest => "nearest",
+        }
+    }
+
+    pub fn wrap_name(&self) -> &'static str {
+        match self.wrap {
+            Wrap::Repeat => "repeat",
+            Wrap::Mirror => "mirror",
+            Wrap::Clamp => "clamp",
+        }
     }
 
     #[inline]

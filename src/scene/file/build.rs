@@ -25,6 +25,16 @@ pub fn build<'i>(src: Source<'i>, def: FileDef<'i>) -> Result<SceneFile, SceneEr
         meshes: Vec::new(),
         origins: super::Origins { path: src.path.to_path_buf(), ..Default::default() },
         media: Default::default(),
+        textured: Vec::new(),
+        one_sided: Vec::new(),
+        perturb: Vec::new(),
+        pending: BTreeMap::new(),
+        defining: Vec::new(),
+        textures: Vec::new(),
+        texture_names: BTreeMap::new(),
+        pending_textures: BTreeMap::new(),
+        surfaces: Vec::new(),
+        frames: Vec::new(),
     }
     .build(def)
 }
@@ -40,6 +50,22 @@ pub(super) struct Builder<'a> {
     pub(super) meshes: Vec<std::path::PathBuf>,
     pub(super) origins: super::Origins,
     pub(super) media: super::medium::MediaDraft,
+    /// Per material: its recipe where it reads textures, whether it is
+    /// one-sided, its normal or bump map.
+    pub(super) textured: Vec<Option<crate::material::Textured>>,
+    pub(super) one_sided: Vec<bool>,
+    pub(super) perturb: Vec<Option<crate::texture::Perturb>>,
+    /// The named materials not built yet, and those being built (a
+    /// material nested by name is built where it is first named).
+    pub(super) pending: BTreeMap<String, Entry<'a>>,
+    pub(super) defining: Vec<String>,
+    pub(super) textures: Vec<crate::texture::Texture>,
+    pub(super) texture_names: BTreeMap<String, u32>,
+    pub(super) pending_textures: BTreeMap<String, Entry<'a>>,
+    /// Per primitive, its texture coordinates (where it has any besides
+    /// its barycentrics), and the analytic shapes' frames they name.
+    pub(super) surfaces: Vec<crate::texture::SurfaceUv>,
+    pub(super) frames: Vec<glam::Affine3A>,
 }
 
 /// A value with its span and its place in the file, for checks.
@@ -117,25 +143,17 @@ impl<'a> Builder<'a> {
     }
 
     fn build(mut self, def: FileDef<'a>) -> Result<SceneFile, SceneError> {
-        for (name, mut m) in def.materials {
-            let material = self.material(&mut m)?;
-            if let Material::Phong(p) = material {
-                if p.albedo_bound() > 1.0 {
-                    self.not_physical.push(self.src.error(
-                        m.kind.span(),
-                        format!("materials.{name}"),
-                        format!(
-                            "m_l C + m_s S + m_r C reaches {:.3} > 1: the material reflects more light than it \
-                             receives, which photon mapping cannot render (lower m_l, m_s or m_r)",
-                            p.albedo_bound()
-                        ),
-                    ));
-                }
-            }
-            self.materials.push(material);
-            let place = self.place(m.kind.span(), format!("materials.{name}"));
-            self.origins.materials.push(place);
-            self.names.insert(name, self.materials.len() as u32 - 1);
+        self.pending_textures = def.textures;
+        let names: Vec<String> = def.materials.keys().cloned().collect();
+        self.pending = def.materials;
+        for name in names {
+            self.define_material(&name)?;
+        }
+        // Textures no material names are read all the same (a missing
+        // file is a mistake wherever it is written).
+        let textures: Vec<String> = self.pending_textures.keys().cloned().collect();
+        for name in textures {
+            self.define_texture(&name)?;
         }
         for (name, m) in def.media {
             self.medium(name, m)?;
@@ -181,11 +199,31 @@ impl<'a> Builder<'a> {
             lights: self.lights,
             ambient,
             camera,
-            one_sided: Vec::new(),
+            one_sided: if self.one_sided.iter().any(|&b| b) { self.one_sided } else { Vec::new() },
             paths: crate::scene::PathLimits::default(),
             texturing: Default::default(),
             media,
         };
+        let mut parts = parts;
+        if self.textured.iter().any(Option::is_some) || self.perturb.iter().any(Option::is_some) {
+            let mut surfaces = self.surfaces;
+            surfaces.resize(parts.prims.len(), crate::texture::SurfaceUv::Barycentric);
+            // A triangle's coordinates are its barycentrics, as a mesh's
+            // without coordinates of its own in Mitsuba (mesh.cpp).
+            for (s, p) in surfaces.iter_mut().zip(&parts.prims) {
+                if let (crate::texture::SurfaceUv::Barycentric, crate::shape::Shape::Triangle(_)) = (*s, &p.shape) {
+                    *s = crate::texture::SurfaceUv::Triangle([glam::Vec2::ZERO, glam::Vec2::X, glam::Vec2::Y]);
+                }
+            }
+            parts.texturing = crate::scene::Texturing {
+                textures: self.textures,
+                materials: self.textured,
+                surfaces,
+                frames: self.frames,
+                perturb: self.perturb,
+                light_patterns: Vec::new(),
+            };
+        }
         Ok(SceneFile {
             parts,
             origins: self.origins,
@@ -244,7 +282,7 @@ impl<'a> Builder<'a> {
     }
 
     /// Where the text at `span` is, as a [`super::Place`].
-    fn place(&self, span: Range<usize>, field: String) -> super::Place {
+    pub(super) fn place(&self, span: Range<usize>, field: String) -> super::Place {
         let e = self.src.error(span, field, "");
         super::Place { line: e.line, column: e.column, field: e.field }
     }

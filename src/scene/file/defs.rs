@@ -29,10 +29,12 @@ pub struct FileDef<'i> {
     pub lights: Vec<Entry<'i>>,
     /// Participating media by name, in the order of their names.
     pub media: BTreeMap<String, Entry<'i>>,
+    /// Textures by name.
+    pub textures: BTreeMap<String, Entry<'i>>,
 }
 
 /// The keys of the top level.
-const TOP: [&str; 6] = ["camera", "ambient", "materials", "shapes", "lights", "media"];
+const TOP: [&str; 7] = ["camera", "ambient", "materials", "shapes", "lights", "media", "textures"];
 
 impl<'i> FileDef<'i> {
     /// The file's structure, or its first mistake (a syntax error, a key
@@ -41,7 +43,7 @@ impl<'i> FileDef<'i> {
         let root = DeTable::parse(src.text).map_err(|e| src.syntax_error(&e))?;
         let (mut camera, mut ambient) = (None, None);
         let (mut materials, mut shapes, mut lights) = (BTreeMap::new(), Vec::new(), Vec::new());
-        let mut media = BTreeMap::new();
+        let (mut media, mut textures) = (BTreeMap::new(), BTreeMap::new());
         for (key, value) in root.into_inner() {
             match key.get_ref().as_ref() {
                 "camera" => camera = Some(src.read(value, "camera")?),
@@ -60,6 +62,13 @@ impl<'i> FileDef<'i> {
                         media.insert(name, entry);
                     }
                 }
+                "textures" => {
+                    for (name, table) in src.table(value, "textures")? {
+                        let name = name.into_inner().into_owned();
+                        let entry = Entry::new(src, format!("textures.{name}"), table)?;
+                        textures.insert(name, entry);
+                    }
+                }
                 "shapes" => shapes = src.entries(value, "shapes")?,
                 "lights" => lights = src.entries(value, "lights")?,
                 other => {
@@ -73,7 +82,7 @@ impl<'i> FileDef<'i> {
             }
         }
         let camera = camera.ok_or_else(|| src.error(0..0, "(top level)", "missing field `camera`"))?;
-        Ok(FileDef { camera, ambient, materials, shapes, lights, media })
+        Ok(FileDef { camera, ambient, materials, shapes, lights, media, textures })
     }
 }
 
@@ -89,7 +98,7 @@ pub struct Entry<'i> {
 }
 
 impl<'i> Entry<'i> {
-    fn new(src: &Source, field: String, value: Spanned<DeValue<'i>>) -> Result<Entry<'i>, SceneError> {
+    pub fn new(src: &Source, field: String, value: Spanned<DeValue<'i>>) -> Result<Entry<'i>, SceneError> {
         let span = value.span();
         let DeValue::Table(mut table) = value.into_inner() else {
             return Err(src.error(span, field, "must be a table (with its `type`)"));
@@ -111,6 +120,21 @@ impl<'i> Entry<'i> {
         match self.rest.as_mut().map(|r| r.get_mut()) {
             Some(DeValue::Table(t)) => t.remove(key),
             _ => None,
+        }
+    }
+
+    /// The rest of the table, key by key (for a type whose fields are
+    /// listed by `material::params`).
+    pub fn fields(&mut self) -> Vec<(Spanned<String>, Spanned<DeValue<'i>>)> {
+        match self.rest.take().map(|r| r.into_inner()) {
+            Some(DeValue::Table(t)) => t
+                .into_iter()
+                .map(|(k, v)| {
+                    let span = k.span();
+                    (Spanned::new(span, k.into_inner().into_owned()), v)
+                })
+                .collect(),
+            _ => Vec::new(),
         }
     }
 

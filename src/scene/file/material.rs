@@ -1,5 +1,6 @@
 //! `[materials.NAME]`: the materials a scene names, with their fields.
 
+use super::bsdf::{Built, NOTHING};
 use super::build::{at, At, Builder};
 use super::defs::{Entry, V3};
 use super::SceneError;
@@ -49,11 +50,36 @@ struct PhongDef {
     m_r: Option<Spanned<f32>>,
 }
 
-impl Builder<'_> {
-    pub(super) fn material(&self, entry: &mut Entry) -> Result<Material, SceneError> {
+impl<'a> Builder<'a> {
+    /// A material table (named or inline).
+    pub(super) fn material(&mut self, entry: &mut Entry<'a>) -> Result<Built, SceneError> {
+        let plain = match self.plain_material(entry)? {
+            Some(m) => m,
+            None => match self.bsdf(entry)? {
+                Some(built) => return Ok(built),
+                None => {
+                    let kind = entry.kind();
+                    return self.fail(
+                        kind.span.clone(),
+                        &kind.field,
+                        format!(
+                            "unknown material type \"{}\" (lambertian, mirror, glass, phong, null, diffuse, conductor, \
+                             roughconductor, roughdielectric, thindielectric, plastic, roughplastic, principled, \
+                             principledthin, blendbsdf, mask, bumpmap, normalmap, twosided)",
+                            kind.value
+                        ),
+                    );
+                }
+            },
+        };
+        Ok((plain, None, false, None))
+    }
+
+    /// The materials of photonmap's own types, or `None` for another type.
+    fn plain_material(&self, entry: &mut Entry) -> Result<Option<Material>, SceneError> {
         let prefix = entry.field.clone();
         let f = |n: &str| format!("{prefix}.{n}");
-        match entry.kind.get_ref().as_str() {
+        let m = match entry.kind.get_ref().as_str() {
             "lambertian" => {
                 let d: LambertianDef = entry.read(&self.src)?;
                 let rho = at(&d.rho, f("rho"));
@@ -98,24 +124,11 @@ impl Builder<'_> {
             }
             "null" => {
                 let _: NullDef = entry.read(&self.src)?;
-                Ok(Material::Masked(crate::material::Masked { opacity: 0.0, rho: Color::ZERO }))
+                Ok(NOTHING)
             }
-            _ => match self.mitsuba_bsdf(entry)? {
-                Some(m) => Ok(m),
-                None => {
-                    let kind = entry.kind();
-                    self.fail(
-                        kind.span.clone(),
-                        &kind.field,
-                        format!(
-                            "unknown material type \"{}\" (lambertian, mirror, glass, phong, null, conductor, \
-                             roughconductor, roughdielectric, thindielectric, plastic, roughplastic)",
-                            kind.value
-                        ),
-                    )
-                }
-            },
-        }
+            _ => return Ok(None),
+        };
+        m.map(Some)
     }
 
     /// A reflectance over one creates energy.
@@ -126,15 +139,72 @@ impl Builder<'_> {
         Ok(())
     }
 
-    /// The index of the material named at `name` (the field `field`).
-    pub(super) fn material_ref(&self, name: &Spanned<String>, field: String) -> Result<u32, SceneError> {
-        self.names.get(name.get_ref().as_str()).copied().ok_or_else(|| {
-            let known: Vec<&str> = self.names.keys().map(String::as_str).collect();
+    /// The index of the material named at `name` (the field `field`),
+    /// built now if it is not yet (a material nested by name).
+    pub(super) fn material_ref(&mut self, name: &Spanned<String>, field: String) -> Result<u32, SceneError> {
+        if let Some(&m) = self.names.get(name.get_ref().as_str()) {
+            return Ok(m);
+        }
+        if self.defining.iter().any(|d| d == name.get_ref()) {
+            return self.fail(
+                name.span(),
+                &field,
+                format!("material \"{}\" contains itself (through {})", name.get_ref(), self.defining.join(" -> ")),
+            );
+        }
+        if self.pending.contains_key(name.get_ref()) {
+            return self.define_material(name.get_ref());
+        }
+        Err({
+            let mut known: Vec<&str> = self.names.keys().map(String::as_str).collect();
+            known.extend(self.pending.keys().map(String::as_str));
+            known.sort();
             self.src.error(
                 name.span(),
                 field,
                 format!("no material named \"{}\" (defined: {})", name.get_ref(), known.join(", ")),
             )
         })
+    }
+
+    /// Builds the pending material `name` and gives its index.
+    pub(super) fn define_material(&mut self, name: &str) -> Result<u32, SceneError> {
+        if let Some(&m) = self.names.get(name) {
+            return Ok(m);
+        }
+        let Some(mut entry) = self.pending.remove(name) else {
+            return self.fail(0..0, name, "no such material");
+        };
+        self.defining.push(name.to_string());
+        let built = self.material(&mut entry)?;
+        self.defining.pop();
+        if let Material::Phong(p) = built.0 {
+            if p.albedo_bound() > 1.0 {
+                self.not_physical.push(self.src.error(
+                    entry.kind.span(),
+                    format!("materials.{name}"),
+                    format!(
+                        "m_l C + m_s S + m_r C reaches {:.3} > 1: the material reflects more light than it \
+                         receives, which photon mapping cannot render (lower m_l, m_s or m_r)",
+                        p.albedo_bound()
+                    ),
+                ));
+            }
+        }
+        let place = self.place(entry.kind.span(), format!("materials.{name}"));
+        let m = self.push_material(built, place);
+        self.names.insert(name.to_string(), m);
+        Ok(m)
+    }
+
+    /// Adds a material, written at `place`.
+    pub(super) fn push_material(&mut self, built: Built, place: super::Place) -> u32 {
+        let (material, textured, one_sided, perturb) = built;
+        self.materials.push(material);
+        self.textured.push(textured);
+        self.one_sided.push(one_sided);
+        self.perturb.push(perturb);
+        self.origins.materials.push(place);
+        self.materials.len() as u32 - 1
     }
 }

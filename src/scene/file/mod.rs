@@ -13,6 +13,7 @@
 //! field) or the checks of [`build`] (a negative radius, a material that
 //! does not exist, an OBJ file that cannot be read).
 
+mod bsdf;
 mod build;
 mod camera;
 mod defs;
@@ -20,9 +21,9 @@ mod light;
 mod locate;
 mod material;
 mod medium;
-mod mitsuba_bsdf;
 mod read;
 mod shape;
+mod texture;
 
 use super::SceneParts;
 use locate::Source;

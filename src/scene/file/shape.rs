@@ -8,6 +8,7 @@ use crate::math::Color;
 use crate::scene::mesh::load_obj;
 use crate::scene::{tncg15_room, Prim};
 use crate::shape::{tetrahedron, Disk, Ellipsoid, Shape, Sphere, Triangle};
+use crate::texture::SurfaceUv;
 use glam::{Affine3A, Vec3};
 use serde::Deserialize;
 use std::ops::Range;
@@ -78,6 +79,9 @@ struct RoomDef {
     ceiling: Spanned<String>,
     walls: Spanned<Vec<Spanned<String>>>,
 }
+
+/// Per triangle, the vertex normals and texture coordinates at its corners.
+type Corners<'c> = (Option<&'c [[Vec3; 3]]>, Option<&'c [[glam::Vec2; 3]]>);
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -155,7 +159,7 @@ impl Builder<'_> {
                     }
                     vec![Triangle::new(v[0], v[1], v[2]), Triangle::new(v[0], v[2], v[3])]
                 };
-                self.triangles(i, &d.material, emission, &triangles, None, d.vertices.span())?;
+                self.triangles(i, &d.material, emission, &triangles, (None, None), d.vertices.span())?;
             }
             "mesh" => {
                 let d: Mesh = entry.read(&self.src)?;
@@ -186,13 +190,21 @@ impl Builder<'_> {
                         })
                         .collect::<Vec<_>>()
                 });
-                self.triangles(i, &d.material, emission, &triangles, normals.as_deref(), kind_span)?;
+                // Texture coordinates as Mitsuba reads an OBJ's: v from the
+                // bottom of the image (obj.cpp's flip_tex_coords).
+                let uvs = mesh
+                    .uvs
+                    .map(|uvs| uvs.iter().map(|t| t.map(|uv| glam::Vec2::new(uv.x, 1.0 - uv.y))).collect::<Vec<_>>());
+                let corners = (normals.as_deref(), uvs.as_deref());
+                self.triangles(i, &d.material, emission, &triangles, corners, kind_span)?;
             }
             "sphere" => {
                 let d: SphereDef = self.read_shape(&mut entry)?;
                 let material = self.material_ref(&d.material, f("material"))?;
                 let center = self.finite(&at(&d.center, f("center")))?;
                 let radius = self.number(&at(&d.radius, f("radius")), 0.0, f32::INFINITY, true)?;
+                let frame = super::texture::sphere_frame(center, radius);
+                self.surface(self.prims.len(), frame, SurfaceUv::Sphere);
                 self.prims.push(Prim { shape: Shape::Sphere(Sphere { center, radius }), material, object });
             }
             "ellipsoid" => {
@@ -217,7 +229,9 @@ impl Builder<'_> {
                 let center = self.finite(&at(&d.center, f("center")))?;
                 let normal = self.direction(&at(&d.normal, f("normal")))?;
                 let radius = self.number(&at(&d.radius, f("radius")), 0.0, f32::INFINITY, true)?;
-                self.prims.push(Prim { shape: Shape::Disk(Disk { center, normal, radius }), material, object });
+                let disk = Disk { center, normal, radius };
+                self.surface(self.prims.len(), super::texture::disk_frame(&disk), SurfaceUv::Disk);
+                self.prims.push(Prim { shape: Shape::Disk(disk), material, object });
             }
             "room" => {
                 let d: RoomDef = self.read_shape(&mut entry)?;
@@ -271,17 +285,19 @@ impl Builder<'_> {
 
     /// Triangles of a triangle or mesh shape: lights when emissive, else
     /// primitives of the named material. Zero-area triangles are dropped.
-    /// Triangles of shape `i` (with their vertex normals, if smooth).
+    /// Triangles of shape `i` (with their vertex normals, if smooth, and
+    /// texture coordinates, if it has them).
     pub(super) fn triangles(
         &mut self,
         i: usize,
         material: &Option<Spanned<String>>,
         emission: Option<Color>,
         triangles: &[Triangle],
-        normals: Option<&[[Vec3; 3]]>,
+        (normals, uvs): Corners,
         span: Range<usize>,
     ) -> Result<(), SceneError> {
         let mut kept = Vec::with_capacity(triangles.len());
+        let mut kept_uvs = Vec::new();
         for (j, t) in triangles.iter().enumerate() {
             if !(t.area() > 0.0 && t.normal.is_finite()) {
                 continue;
@@ -292,6 +308,9 @@ impl Builder<'_> {
                 self.shading_normals.push(n);
             }
             kept.push(t);
+            if let Some(uvs) = uvs {
+                kept_uvs.push(uvs[j]);
+            }
         }
         if kept.is_empty() {
             return self.fail(span, &format!("shapes[{i}]"), "has no triangle of non-zero area");
@@ -318,6 +337,9 @@ impl Builder<'_> {
                 };
                 let material = self.material_ref(m, field)?;
                 let object = i as u32;
+                for (k, uv) in kept_uvs.into_iter().enumerate() {
+                    self.surface_uv(self.prims.len() + k, SurfaceUv::Triangle(uv));
+                }
                 self.prims.extend(kept.into_iter().map(|t| Prim { shape: Shape::Triangle(t), material, object }));
             }
         }

@@ -7,6 +7,7 @@
 use super::props::Plugin;
 use super::spectrum::{named_ior, Use};
 use super::Builder;
+use crate::material::params::{self, Spec};
 use crate::material::{Distribution, Material, Param, Textured};
 use crate::math::Color;
 use crate::scene::file::SceneError;
@@ -47,13 +48,13 @@ impl Builder<'_> {
         Ok(m)
     }
 
-    /// A reflectance: a colour within [0, 1] or a texture.
-    pub(super) fn reflectance(&mut self, p: &Plugin, name: &str, default: f32) -> Result<Param, SceneError> {
-        let param = self.param(p, name, Use::Reflectance, Color::splat(default))?;
-        if let Param::Fixed(c) = param {
-            bounded(p, name, c)?;
+    /// Parameter `name` of plugin `p` by its definition in `list`
+    /// (`material::params`, shared with the TOML reader).
+    fn defined(&mut self, p: &Plugin, list: &[Spec], name: &str) -> Result<Param, SceneError> {
+        match params::find(list, name) {
+            Some(s) => self.spec_param(p, s),
+            None => Err(p.refuse(format!("'{name}' is not a parameter of the '{}' BSDF", p.kind))),
         }
-        Ok(param)
     }
 
     fn bsdf_of(&mut self, p: &Plugin) -> Result<Built, SceneError> {
@@ -82,17 +83,12 @@ impl Builder<'_> {
     fn bsdf_nested(&mut self, p: &Plugin) -> Result<Built, SceneError> {
         let recipe = match p.kind {
             "diffuse" => {
-                let reflectance = self.reflectance(p, "reflectance", 0.5)?;
+                let reflectance = self.defined(p, params::DIFFUSE, "reflectance")?;
                 p.finish("reflectance")?;
                 (Textured::Diffuse { reflectance }, true)
             }
             "blendbsdf" => {
-                let weight = self.param(p, "weight", Use::Unbounded, Color::splat(0.5))?;
-                if let Param::Fixed(w) = weight {
-                    if !(0.0..=1.0).contains(&w.x) {
-                        return Err(p.fail(p.loc(), "weight", format!("must lie in [0, 1], got {}", w.x)));
-                    }
-                }
+                let weight = self.defined(p, params::BLEND, "weight")?;
                 let inner = p.objects("bsdf")?;
                 p.finish("weight, two nested <bsdf>")?;
                 let [a, b] = &inner[..] else {
@@ -115,7 +111,7 @@ impl Builder<'_> {
                         None => return Err(p.refuse("a normalmap needs a 'normalmap' texture")),
                     }
                 } else {
-                    let scale = p.float_in("scale", 1.0, -1e6, 1e6)? as f32;
+                    let scale = self.defined(p, params::BUMP_MAP, "scale")?.mean(&[]).x;
                     let textures = p.objects("texture")?;
                     let [t] = &textures[..] else {
                         return Err(p.refuse(format!("a bumpmap needs one nested <texture>, got {}", textures.len())));
@@ -141,12 +137,7 @@ impl Builder<'_> {
                 return Ok((Material::Masked(nothing), None, false, None));
             }
             "mask" => {
-                let opacity = self.param(p, "opacity", Use::Unbounded, Color::splat(0.5))?;
-                if let Param::Fixed(o) = opacity {
-                    if !(0.0..=1.0).contains(&o.x) {
-                        return Err(p.fail(p.loc(), "opacity", format!("must lie in [0, 1], got {}", o.x)));
-                    }
-                }
+                let opacity = self.defined(p, params::MASK, "opacity")?;
                 let inner = p.objects("bsdf")?;
                 p.finish("opacity, one nested <bsdf>")?;
                 let [q] = &inner[..] else {
@@ -177,7 +168,7 @@ impl Builder<'_> {
             }
             "conductor" | "roughconductor" => {
                 let (eta, k) = complex_ior(p)?;
-                let specular = self.reflectance(p, "specular_reflectance", 1.0)?;
+                let specular = self.defined(p, params::CONDUCTOR, "specular_reflectance")?;
                 if p.kind == "conductor" {
                     p.finish("material, eta, k, specular_reflectance")?;
                     // eta 0 + 1i (material 'none', the export's mirror)
@@ -199,8 +190,8 @@ impl Builder<'_> {
                 if int == ext {
                     return Err(p.refuse("the interior and exterior indices of refraction must differ"));
                 }
-                let reflectance = self.reflectance(p, "specular_reflectance", 1.0)?;
-                let transmittance = self.reflectance(p, "specular_transmittance", 1.0)?;
+                let reflectance = self.defined(p, params::ROUGH_DIELECTRIC, "specular_reflectance")?;
+                let transmittance = self.defined(p, params::ROUGH_DIELECTRIC, "specular_transmittance")?;
                 if p.kind == "thindielectric" {
                     let (Param::Fixed(r), Param::Fixed(t)) = (reflectance, transmittance) else {
                         return Err(p.refuse("a thindielectric's reflectance and transmittance must be colours"));
@@ -224,8 +215,8 @@ impl Builder<'_> {
                 if int == ext {
                     return Err(p.refuse("the interior and exterior indices of refraction must differ"));
                 }
-                let diffuse = self.reflectance(p, "diffuse_reflectance", 0.5)?;
-                let specular = self.reflectance(p, "specular_reflectance", 1.0)?;
+                let diffuse = self.defined(p, params::PLASTIC, "diffuse_reflectance")?;
+                let specular = self.defined(p, params::PLASTIC, "specular_reflectance")?;
                 let nonlinear = p.boolean("nonlinear", false)?;
                 let (int_ior, ext_ior) = (int as f32, ext as f32);
                 if p.kind == "plastic" {
@@ -335,32 +326,21 @@ impl Builder<'_> {
             if p.tag_of(name).is_none() {
                 return Ok(None);
             }
-            let v = self.param(p, name, Use::Unbounded, Color::ZERO)?;
-            if let Param::Fixed(a) = v {
-                if !(0.0..=10.0).contains(&a.x) {
-                    return Err(p.fail(p.loc(), name, format!("must lie in [0, 10], got {}", a.x)));
-                }
-            }
-            Ok(Some(v))
+            Ok(Some(self.defined(p, params::ROUGH_CONDUCTOR, name)?))
         };
         let alpha = read("alpha")?;
         let (au, av) = if anisotropic { (read("alpha_u")?, read("alpha_v")?) } else { (None, None) };
         let (au, av) = match (alpha, au, av) {
             (Some(a), None, None) => (a, a),
             (None, Some(u), Some(v)) => (u, v),
-            (None, None, None) => (Param::Fixed(Color::splat(0.1)), Param::Fixed(Color::splat(0.1))),
+            (None, None, None) => {
+                let alpha = Param::Fixed(Color::splat(crate::material::defaults::ALPHA));
+                (alpha, alpha)
+            }
             _ => return Err(p.refuse("give either alpha or both alpha_u and alpha_v")),
         };
         Ok((distribution, au, av))
     }
-}
-
-/// A reflectance within [0, 1] per channel.
-fn bounded(p: &Plugin, name: &str, c: Color) -> Result<Color, SceneError> {
-    if c.min_element() < 0.0 || c.max_element() > 1.0 {
-        return Err(p.fail(p.loc(), name, format!("a reflectance must lie in [0, 1], got {c}")));
-    }
-    Ok(c)
 }
 
 /// An index of refraction: a number or a name from Mitsuba's table.
