@@ -18,6 +18,10 @@ pub struct Counters {
     /// Caustic estimates made, and those a pixel's earlier sample answered.
     pub caustic_estimates: u64,
     pub caustic_reused: u64,
+    /// Rays cast between an irradiance-cache lookup and a cache point at
+    /// another level than its surface, and those that found it hidden.
+    pub cache_rays: u64,
+    pub cache_hidden: u64,
     /// First non-finite sample seen: (pixel index, estimator name).
     first_nonfinite: Option<(u64, &'static str)>,
 }
@@ -29,6 +33,8 @@ impl Counters {
         self.shadow_rays_skipped += other.shadow_rays_skipped;
         self.caustic_estimates += other.caustic_estimates;
         self.caustic_reused += other.caustic_reused;
+        self.cache_rays += other.cache_rays;
+        self.cache_hidden += other.cache_hidden;
         if let Some((pixel, estimator)) = other.first_nonfinite {
             self.note_nonfinite(pixel, estimator);
         }

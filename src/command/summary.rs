@@ -62,6 +62,14 @@ impl Summary<'_> {
                 pct(c.caustic_reused, c.caustic_estimates + c.caustic_reused)
             ));
         }
+        if c.cache_rays > 0 {
+            out.push(format!(
+                "               {} rays to cache points at another level, {} hidden ({:.0}%)",
+                c.cache_rays,
+                c.cache_hidden,
+                pct(c.cache_hidden, c.cache_rays)
+            ));
+        }
         let mut skipped = own.skipped;
         if c.shadow_rays_skipped > 0 {
             skipped.push(format!("{} shadow rays to lights facing away", c.shadow_rays_skipped));

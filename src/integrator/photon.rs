@@ -177,7 +177,7 @@ impl<'a> Integrator for PhotonIntegrator<'a> {
         }
         let mut sum = Color::ZERO;
         for p in pending.iter() {
-            sum += p.weight * self.cache.lookup_in(p.point, p.normal, p.cell);
+            sum += p.weight * self.lookup(p.point, p.normal, p.cell, ctx);
         }
         pending.clear();
         ctx.checked(sum, "indirect")
@@ -642,8 +642,22 @@ impl<'a> PhotonIntegrator<'a> {
             sh.thread.pending.push(PendingRead { point, normal, weight: w * weight, ..Default::default() });
             Color::ZERO
         } else {
-            weight * self.cache.lookup(point, normal)
+            weight * self.lookup(point, normal, self.cache.locate(point), sh.ctx)
         }
+    }
+
+    /// The cache's irradiance at `point` (in `cell`), from a cache point
+    /// that no surface hides from it ([`IrradianceCache::lookup_seen`]):
+    /// the shadow rays that asks for are counted.
+    fn lookup(&self, point: glam::Vec3, normal: glam::Vec3, cell: CellRange, ctx: &mut Context) -> Color {
+        self.cache.lookup_seen(point, normal, cell, |from, to| {
+            let (dir, len) = ((to - from).normalize_or_zero(), from.distance(to));
+            ctx.counters.rays += 1;
+            ctx.counters.cache_rays += 1;
+            let blocked = self.scene.occluded(&Ray::new(from, dir), None, len, None);
+            ctx.counters.cache_hidden += blocked as u64;
+            blocked
+        })
     }
 
     fn checked(&self, c: Color, estimator: &'static str, sh: &mut Shade<'_, '_, 'a>) -> Color {

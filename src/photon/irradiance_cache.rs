@@ -3,12 +3,30 @@
 //! k-nearest estimate each.
 
 use super::facing::FacingTrees;
-use super::map::{bounds, PhotonMap, Scratch, NORMAL_COSINE};
+use super::map::{bounds, in_front, PhotonMap, Scratch, NORMAL_COSINE};
 use super::spots::SpotPoint;
 use super::{normal_times_127, prefetch, quantize_normal};
 use crate::math::Color;
 use glam::Vec3;
 use rayon::prelude::*;
+
+/// How far off each other's plane (as a share of their distance) a lookup
+/// and a cache point at different levels lie before a ray checks what lies
+/// between them ([`IrradianceCache::level_apart`]): beyond rounding, and
+/// below what a surface's bumps and a mesh's facets make.
+const OFF_PLANE: f32 = 0.02;
+
+/// How far such a ray's ends are lifted off their surfaces, as a share of
+/// their distance: above the sagitta of a sphere between two points whose
+/// normals differ by the widest angle a lookup admits (d / 8R of d with
+/// d / R = 2 sin(θ/2) = 0.45 at [`NORMAL_COSINE`]: 0.056 d), but not over a
+/// small object's shell (a lookup reaching 2.4 to a wall 0.6 beside a unit
+/// sphere lifts its ends by 0.15).
+const LIFT: f32 = 0.06;
+
+/// How many hidden cache points a lookup passes over before it reads
+/// nothing: where that many lie behind a surface, so do the rest.
+pub const MAX_HIDDEN: usize = 3;
 
 /// Grid cells of the irradiance cache's index, as a fraction of the lookup
 /// radius (twice the median estimate radius over the surfaces' area).
@@ -59,8 +77,16 @@ struct CachePoint {
 }
 
 impl CachePoint {
-    fn faces(&self, n: Vec3) -> bool {
-        normal_times_127(self.normal).dot(n) >= NORMAL_COSINE * 127.0
+    /// Whether the point answers a lookup at `x` (squared distance `d2`)
+    /// on a surface facing `n`: it faces alike and no surface lies between
+    /// them ([`in_front`]).
+    #[inline]
+    fn answers(&self, x: Vec3, n: Vec3, d2: f32) -> bool {
+        // Both normals 127 times as long, the distance too ([`in_front`]
+        // asks for ratios): no division for the stored normal's unit.
+        const S: f32 = 127.0;
+        let m = normal_times_127(self.normal);
+        (m.dot(n) >= S * NORMAL_COSINE) & in_front(x, S * n, Vec3::from(self.position), m, S * S * d2)
     }
 
     fn normal(&self) -> Vec3 {
@@ -337,17 +363,84 @@ impl IrradianceCache {
 
     /// [`Self::lookup`] with `x`'s cell already found by [`Self::locate`].
     pub fn lookup_in(&self, x: Vec3, n: Vec3, cell: CellRange) -> Color {
+        self.nearest(x, n, cell, &[]).map_or(Color::ZERO, |i| self.irradiance(i))
+    }
+
+    /// [`Self::lookup_in`] where a surface may lie between `x` and the
+    /// point that answers: a point at another level than `x`'s surface
+    /// ([`Self::level_apart`]) answers only where `blocked` (a shadow ray
+    /// between the two, lifted off their surfaces) finds nothing between;
+    /// else the next nearest answers, up to [`MAX_HIDDEN`] of them hidden.
+    /// The plane tests of [`CachePoint::answers`] tell which side of each
+    /// other's surface two points lie, but not what lies between at a
+    /// grazing angle: from inside a small closed object, the wall beside
+    /// it (a lookup reaches up to twice the radius cap).
+    pub fn lookup_seen(&self, x: Vec3, n: Vec3, cell: CellRange, mut blocked: impl FnMut(Vec3, Vec3) -> bool) -> Color {
+        let mut hidden = [u32::MAX; MAX_HIDDEN];
+        for h in 0..=MAX_HIDDEN {
+            let Some(i) = self.nearest(x, n, cell, &hidden[..h]) else { break };
+            match self.level_apart(x, n, i) {
+                Some((from, to)) if blocked(from, to) => {
+                    if h < MAX_HIDDEN {
+                        hidden[h] = i;
+                    }
+                }
+                _ => return self.irradiance(i),
+            }
+        }
+        Color::ZERO
+    }
+
+    fn irradiance(&self, i: u32) -> Color {
+        Vec3::from(self.points[i as usize].irradiance)
+    }
+
+    /// Where cache point `i` lies off the plane of a lookup at `x` (facing
+    /// `n`), and `x` off its plane, on the same side of each other's
+    /// surface (a > 0 and b > 0 below: it above `x` and `x` behind it, an
+    /// overhang; a < 0 and b < 0: it below `x` facing up to it, a step),
+    /// both by more than [`OFF_PLANE`] of their distance: the ends of a
+    /// ray between them, each lifted off its surface by [`LIFT`] of their
+    /// distance. One smooth surface curves the other way (a and b of
+    /// opposite signs, equal on a sphere), its points need no ray (and
+    /// a straight one between two points of a convex surface would cross
+    /// it); points of one plane neither.
+    #[inline]
+    pub fn level_apart(&self, x: Vec3, n: Vec3, i: u32) -> Option<(Vec3, Vec3)> {
+        let point = &self.points[i as usize];
+        let (p, m) = (Vec3::from(point.position), point.normal());
+        let d = p - x;
+        let (a, b) = (n.dot(d), m.dot(d));
+        let (off, d2) = (a.abs().min(b.abs()), d.length_squared());
+        if !(a * b > 0.0 && off * off > OFF_PLANE * OFF_PLANE * d2) {
+            return None;
+        }
+        // Rounding: points of one plane lie off each other's by about the
+        // coordinates' precision.
+        let noise = 1e-5 * x.abs().max_element().max(p.abs().max_element()).max(1.0);
+        let dist = d2.sqrt();
+        if off <= OFF_PLANE * dist + noise {
+            return None;
+        }
+        let lift = LIFT * dist + noise;
+        Some((x + lift * n, p + lift * m))
+    }
+
+    /// The cache point that answers a lookup at `x` on a surface facing
+    /// `n` ([`Self::lookup`]), but none of `hidden`.
+    #[inline]
+    fn nearest(&self, x: Vec3, n: Vec3, cell: CellRange, hidden: &[u32]) -> Option<u32> {
         if let Some((start, end)) = cell.0 {
-            let mut best: Option<(f32, &CachePoint)> = None;
-            for p in &self.points[start as usize..end as usize] {
+            let mut best: Option<(f32, u32)> = None;
+            for (i, p) in (start..end).zip(&self.points[start as usize..end as usize]) {
                 let d2 = Vec3::from(p.position).distance_squared(x);
                 let q = d2 * p.inv_reach2;
-                if q <= 1.0 && best.is_none_or(|b| q < b.0) && p.faces(n) {
-                    best = Some((q, p));
+                if q <= 1.0 && best.is_none_or(|b| q < b.0) && p.answers(x, n, d2) && !hidden.contains(&i) {
+                    best = Some((q, i));
                 }
             }
-            if let Some((_, p)) = best {
-                return Vec3::from(p.irradiance);
+            if let Some((_, i)) = best {
+                return Some(i);
             }
         }
         // The classes that may face like `n`, and how far any of their
@@ -364,8 +457,13 @@ impl IrradianceCache {
             for c in self.trees.facing(n) {
                 self.trees.visit_in(c, x, r2, |i| {
                     let p = &self.points[i as usize];
-                    let q = Vec3::from(p.position).distance_squared(x) * p.inv_reach2;
-                    if q <= 1.0 && best.is_none_or(|b| q < b.0 || (q == b.0 && i < b.1)) && p.faces(n) {
+                    let d2 = Vec3::from(p.position).distance_squared(x);
+                    let q = d2 * p.inv_reach2;
+                    if q <= 1.0
+                        && best.is_none_or(|b| q < b.0 || (q == b.0 && i < b.1))
+                        && p.answers(x, n, d2)
+                        && !hidden.contains(&i)
+                    {
                         best = Some((q, i));
                     }
                 });
@@ -373,7 +471,7 @@ impl IrradianceCache {
             // Every point that could beat the best lies within this (q <= 1).
             let enough2 = best.map_or(max_reach2, |(q, _)| q * max_reach2);
             if r2 >= enough2 {
-                return best.map_or(Color::ZERO, |(_, i)| Vec3::from(self.points[i as usize].irradiance));
+                return best.map(|(_, i)| i);
             }
             r2 = (4.0 * r2).min(enough2);
         }
@@ -388,6 +486,60 @@ mod tests {
     use crate::sampling::{next_2d, stream, Domain};
     use glam::Vec2;
     use rand::RngExt;
+
+    /// A lookup on a surface 0.3 above a lit floor, facing up like it (the
+    /// inside of a small closed object standing there): the floor's sparse
+    /// points reach it at grazing angles, where no plane test tells that a
+    /// surface lies between, so it asks for a ray to each, its ends lifted
+    /// off both surfaces; with every ray blocked it reads nothing, with
+    /// none what the plain lookup reads. On the floor itself it asks none.
+    #[test]
+    fn lookups_at_another_level_ask_for_a_ray() {
+        let map = PhotonMap::build(uniform_floor(12, 400));
+        let cache = IrradianceCache::build(&map, 1, 100, 10.0);
+        let mut rng = stream(13, Domain::Camera, 0);
+        let (mut asked, mut answered) = (0, 0);
+        for _ in 0..100 {
+            let u = next_2d(&mut rng) * 4.0;
+            let (x, floor) = (Vec3::new(u.x, 0.3, u.y), Vec3::new(u.x, 0.0, u.y));
+            let cell = cache.locate(x);
+            let plain = cache.lookup_in(x, Vec3::Y, cell);
+            answered += (plain != Color::ZERO) as usize;
+            let mut rays = 0;
+            let hidden = cache.lookup_seen(x, Vec3::Y, cell, |from, to| {
+                rays += 1;
+                assert!(from.y > 0.3 && to.y > 0.0 && to.y < 0.3, "{from} to {to}");
+                true
+            });
+            assert_eq!(hidden, Color::ZERO, "at {x}");
+            assert!(plain == Color::ZERO || (1..=MAX_HIDDEN + 1).contains(&rays), "{rays} rays at {x}");
+            asked += rays;
+            assert_eq!(cache.lookup_seen(x, Vec3::Y, cell, |_, _| false), plain, "at {x}");
+            let on_floor = cache.lookup_seen(floor, Vec3::Y, cache.locate(floor), |_, _| panic!("a ray on the floor"));
+            assert_eq!(on_floor, cache.lookup(floor, Vec3::Y));
+        }
+        // Most lookups found a point: the case is real, and each asked.
+        assert!(answered > 50 && asked >= answered, "{answered} answered, {asked} rays");
+    }
+
+    /// Cache points on the outside of a unit sphere answer no lookup from
+    /// its inside, however far they reach; from the outside they answer
+    /// with the photons' density.
+    #[test]
+    fn lookups_do_not_read_through_a_closed_surface() {
+        let map = PhotonMap::build(crate::photon::map::tests::sphere_outside(10, 40_000));
+        let cache = IrradianceCache::build(&map, 8, 100, 3.0);
+        let mut rng = stream(11, Domain::Camera, 0);
+        let mut outside = 0.0;
+        for _ in 0..200 {
+            let d = crate::sampling::uniform_cone(next_2d(&mut rng), -1.0).normalize();
+            assert_eq!(cache.lookup(d, -d), Color::ZERO, "at {d}");
+            assert_eq!(cache.lookup(0.5 * d, -d), Color::ZERO, "at {}", 0.5 * d);
+            outside += cache.lookup(d, d).x as f64;
+        }
+        let mean = outside / 200.0 * 4.0 * std::f64::consts::PI;
+        assert!((mean - 1.0).abs() < 0.05, "outside: {mean} of the density");
+    }
 
     /// A map without a tree (nor a Morton order) picks its cache points
     /// along its grid's cells: still spread evenly, so that lookups all over
@@ -573,8 +725,9 @@ mod tests {
             let best_of = |points: &[CachePoint]| {
                 let mut best: Option<(f32, usize)> = None;
                 for (i, p) in points.iter().enumerate() {
-                    let q = Vec3::from(p.position).distance_squared(x) * p.inv_reach2;
-                    if q <= 1.0 && p.faces(n) && best.is_none_or(|b| q < b.0) {
+                    let d2 = Vec3::from(p.position).distance_squared(x);
+                    let q = d2 * p.inv_reach2;
+                    if q <= 1.0 && p.answers(x, n, d2) && best.is_none_or(|b| q < b.0) {
                         best = Some((q, i));
                     }
                 }
