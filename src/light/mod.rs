@@ -21,6 +21,7 @@
 //! it in a scene front-end (notes/architecture.md).
 
 mod area;
+mod bounds;
 mod directional;
 mod environment;
 pub mod infinity;
@@ -31,11 +32,12 @@ mod sky;
 mod spot;
 
 pub use area::{AreaLight, AreaPattern, Emitting, LightSample};
+pub use bounds::LightBounds;
 pub use directional::Directional;
 pub use environment::Environment;
 pub use point::PointLight;
 pub use projector::Projector;
-pub use sampler::{draws, LightBounds, LightSampler};
+pub use sampler::{draws, LightSampler};
 pub use sky::Constant;
 pub use spot::Spot;
 

@@ -3,7 +3,8 @@
 //! k-nearest estimate each.
 
 use super::facing::FacingTrees;
-use super::map::{bounds, in_front, PhotonMap, Scratch, NORMAL_COSINE};
+use super::map::{in_front, PhotonMap, Scratch, NORMAL_COSINE};
+use super::morton::bounds;
 use super::spots::SpotPoint;
 use super::{normal_times_127, prefetch, quantize_normal};
 use crate::math::Color;

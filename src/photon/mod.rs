@@ -19,6 +19,7 @@ pub mod irradiance_cache;
 mod kdtree;
 pub mod map;
 pub mod media_trace;
+mod morton;
 pub mod spots;
 pub mod trace;
 pub mod volume_map;

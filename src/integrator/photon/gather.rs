@@ -1,0 +1,269 @@
+//! Final gathering (light → … diffuse y → specular* → x): the camera
+//! pass's gather rays from a diffuse point, cosine-distributed and aimed at
+//! mirrors, glass and bright spots, followed through specular chains and
+//! glossy lobes to the surfaces whose precomputed irradiance they read.
+
+use super::*;
+
+/// The density of all of a point's gather rays together towards a
+/// direction of cosine `cos`: `nc` cosine rays and `na` aimed ones, whose
+/// density `aimed_pdf` gives.
+pub(super) fn gather_density(cos: f32, nc: u32, na: u32, aimed_pdf: impl FnOnce() -> f32) -> f32 {
+    if !(cos > 0.0) {
+        return 0.0;
+    }
+    nc as f32 * cos / PI + if na > 0 { na as f32 * aimed_pdf() } else { 0.0 }
+}
+
+/// The fractional part of the golden ratio: a sequence stepping by it
+/// fills [0, 1) evenly at every length.
+const GOLDEN_RATIO_FRACTION: f32 = 0.618_034;
+
+impl<'a> PhotonIntegrator<'a> {
+    /// Light → … diffuse y → (specular*) → x: final gathering.
+    ///
+    /// Each read of the cache is a cache miss (gather hits land anywhere in
+    /// the scene): the reads are left for the end of the pixel's samples
+    /// ([`PendingRead`]), all of their fetches under way at once. The
+    /// random numbers are drawn in the same order either way.
+    ///
+    /// Where the point sees a mirror or glass object or a bright spot, some
+    /// of the rays are aimed at them ([`super::aim`]).
+    /// With `mis`, the rays also bring the direct light from infinity
+    /// they meet, weighted against the shadow rays'.
+    pub(super) fn indirect(
+        &self,
+        hit: &Hit,
+        n: glam::Vec3,
+        rho: Color,
+        w: Color,
+        mis: bool,
+        sh: &mut Shade<'_, '_, 'a>,
+    ) -> Color {
+        let count = self.settings.gather_rays;
+        if count == 0 || self.cache.is_empty() {
+            return Color::ZERO;
+        }
+        let (cosine, aimed) = self.gather_split(hit, n, sh);
+        let frame = Frame::from_normal(n);
+        // Each ray, cosine or aimed, weighed by the balance heuristic:
+        // f cos / (cosine p_cos + aimed p_aim), f = rho / pi, p_cos = cos / pi;
+        // with cosine rays alone, 1 / count.
+        let (nc, na) = (cosine as f32, aimed as f32);
+        let mut sum = Color::ZERO;
+        for g in 0..count {
+            let dir = if g < cosine {
+                frame.to_world(cosine_hemisphere(stratified_2d(g, cosine, next_2d(sh.ctx.rng)))).normalize()
+            } else {
+                let pick = match sh.pixel.aim_pick {
+                    Some(p) => p,
+                    None => sh.ctx.rng.random::<f32>(),
+                };
+                sh.pixel.aim_pick = Some((pick + GOLDEN_RATIO_FRACTION).fract());
+                sh.thread.aims.sample(pick, next_2d(sh.ctx.rng))
+            };
+            let cos = dir.dot(n);
+            // About a shading normal a gather ray may point into the
+            // surface: it gathers nothing.
+            if !(cos > 0.0) || (hit.shading_normal != hit.normal && !hit.leaves_as(-n, dir, true)) {
+                continue;
+            }
+            let c = if aimed == 0 { 1.0 / nc } else { cos / (nc * cos + na * PI * sh.thread.aims.pdf(dir)) };
+            let sample = mis.then(|| {
+                let aims = &sh.thread.aims;
+                let pdf = gather_density(cos, cosine, aimed, || aims.pdf(dir));
+                BsdfSample { compensated: true, ..self.bsdf_sample(hit, n, pdf) }
+            });
+            let (ray, dep) = hit.spawn(dir);
+            sum += c * self.gather(ray, dep, Lobe::Diffuse, sample, w * rho * c, sh);
+        }
+        rho * sum
+    }
+
+    /// How many of the gather rays at `hit` are cosine and how many aimed
+    /// (the aims prepared for it).
+    pub(super) fn gather_split(&self, hit: &Hit, n: glam::Vec3, sh: &mut Shade<'_, '_, 'a>) -> (u32, u32) {
+        let count = self.settings.gather_rays;
+        let aims = self.settings.aimed_gather_rays.min(count.saturating_sub(1));
+        let aimed = if aims > 0 && sh.thread.aims.prepare(self.aims(hit.point), hit.point, n) { aims } else { 0 };
+        (count - aimed, aimed)
+    }
+
+    /// What final gathering aims at: the mirror and glass objects' bounding
+    /// spheres, and the bright spots that face `x`: a flat one's irradiance
+    /// over its plane, a curved one's bounding sphere (either is an
+    /// unbiased choice, the weights use the pdf of what was sampled; the
+    /// map follows a flat spot's light closely).
+    pub(super) fn aims(&self, x: glam::Vec3) -> impl Iterator<Item = Aim<'a>> + 'a {
+        let targets = self.targets.iter().map(|t| Aim::Sphere(t.center, t.radius));
+        targets.chain(self.spots.iter().filter(move |s| s.faces(x)).map(|s| match &s.patch {
+            Some(map) => Aim::Patch(map, s.radius),
+            None => Aim::Sphere(s.center, s.radius),
+        }))
+    }
+
+    /// Radiance arriving along a gather ray that left a non-specular lobe
+    /// (`from`), as far as this estimator is the one to count it: followed
+    /// through mirrors and glass and through glossy lobes; at every surface
+    /// met, its diffuse lobe's light is read from the irradiance cache (the
+    /// read left for later, with weight `w` and the path's), and its glossy
+    /// lobe takes its direct light by shadow rays. Light met after mirrors
+    /// or glass (a light's surface, or light from everywhere where the ray
+    /// leaves the scene) counts only where the last non-specular vertex was
+    /// glossy: a diffuse one's is the caustic map's. Light met straight
+    /// from a non-specular vertex is its direct estimate's, but where that
+    /// vertex shared its direct light with the lobe's sample (`shared`:
+    /// MIS at glossy lobes, [`super::mis`]): then it counts with the
+    /// sample's weight (notes/method.md).
+    ///
+    /// A glossy lobe that carries caustics ([`crate::material::Glossy`])
+    /// stands for a specular one while the path is still a diffuse
+    /// vertex's (`from` diffuse): the light it brings is the caustic map's,
+    /// so it takes no shadow rays and is passed through like glass.
+    pub(super) fn gather(
+        &self,
+        mut ray: Ray,
+        mut dep: Departure,
+        mut from: Lobe,
+        mut shared: Option<BsdfSample>,
+        w: Color,
+        sh: &mut Shade<'_, '_, 'a>,
+    ) -> Color {
+        let mut weight = Color::ONE;
+        // A mirror or glass vertex since the last non-specular one.
+        let mut specular = false;
+        let mut found = Color::ZERO;
+        for _ in 0..MAX_SPECULAR_DEPTH {
+            sh.ctx.counters.rays += 1;
+            let Some(y) = self.scene.intersect(&ray, Some(dep)) else {
+                // Light from everywhere: as a light's surface below.
+                if from == Lobe::Glossy && specular {
+                    found += weight * self.scene.background(ray.dir);
+                } else if let Some(b) = shared {
+                    found += weight * b.from_infinity(self.scene, ray.dir);
+                }
+                break;
+            };
+            weight *= self.scene.transmittance(Some(dep), y.t);
+            let material = &self.scene.material_seen(&y, ray.dir);
+            if from == Lobe::Glossy && specular {
+                found += weight * self.scene.emitted(&y, ray.dir);
+            } else if let Some(b) = shared {
+                // Straight from a glossy vertex that shared its direct light.
+                found += weight * b.emitted(self.scene, &y, ray.dir);
+            }
+            if material.is_emitter() {
+                break;
+            }
+            let (frame, entering) = y.scattering_frame(ray.dir, material);
+            let wo = frame.to_local(-ray.dir);
+            if material.diffuse_rho().is_some() {
+                found += self.read(y.point, frame.n, weight * material.diffuse_albedo(wo) / PI, w, sh);
+            }
+            let glossy = material.glossy();
+            // Whether the glossy lobe here is passed like glass.
+            let caustic_glossy = from == Lobe::Diffuse && glossy.is_some_and(|g| g.carries_caustics());
+            // On through one of the lobes that are not read here: a specular
+            // branch or the glossy lobe, chosen by what each reflects.
+            let branches = material.specular_branches(wo, entering, Transport::Radiance);
+            let p_specular = match glossy {
+                None => 1.0,
+                Some(_) if branches.is_empty() => 0.0,
+                Some(g) => g.specular_share(),
+            };
+            // The glossy lobe's direct light, shared with its sample (MIS)
+            // where the setting asks.
+            let lit = glossy.filter(|_| !caustic_glossy);
+            let mis = lit.filter(|_| self.settings.mis);
+            if let Some(g) = lit {
+                let s = &self.settings;
+                let both = g.transmits();
+                let direct = if mis.is_some() {
+                    let bsdf = |l: glam::Vec3| {
+                        let wi = frame.to_local(l);
+                        let shared = g.eval(wo, wi, entering, Transport::Radiance);
+                        MisBsdf { alone: Color::ZERO, shared, pdf: (1.0 - p_specular) * g.pdf(wo, wi, entering) }
+                    };
+                    direct_light_mis(self.scene, &y, frame.n, bsdf, s.shadow_rays, s.skip, both, sh.ctx)
+                } else {
+                    let brdf = |l: glam::Vec3| g.eval(wo, frame.to_local(l), entering, Transport::Radiance);
+                    direct_light(self.scene, &y, frame.n, brdf, s.shadow_rays, s.skip, both, sh.ctx)
+                };
+                found += weight * direct;
+            }
+            shared = None;
+            let next_dir = if p_specular >= 1.0 || (p_specular > 0.0 && sh.ctx.rng.random::<f32>() < p_specular) {
+                let Some(b) = branches.choose(sh.ctx.rng) else { break };
+                weight *= b.scale / p_specular;
+                specular = true;
+                frame.to_world(b.wi).normalize()
+            } else {
+                let Some((wi, gw)) = glossy.and_then(|g| g.sample(wo, entering, Transport::Radiance, sh.ctx.rng))
+                else {
+                    break;
+                };
+                weight *= gw / (1.0 - p_specular);
+                if caustic_glossy {
+                    specular = true;
+                } else {
+                    (from, specular) = (Lobe::Glossy, false);
+                }
+                if let Some(g) = mis {
+                    let pdf = (1.0 - p_specular) * g.pdf(wo, wi, entering);
+                    shared = Some(BsdfSample {
+                        point: y.point,
+                        normal: frame.n,
+                        pdf,
+                        shadow_rays: self.settings.shadow_rays,
+                        compensated: false,
+                    });
+                }
+                frame.to_world(wi).normalize()
+            };
+            if y.shading_normal != y.normal && !y.leaves_as(ray.dir, next_dir, frame.to_local(next_dir).z > 0.0) {
+                break;
+            }
+            (ray, dep) = y.spawn(next_dir);
+        }
+        found
+    }
+
+    /// The irradiance read at `point` (on a surface facing `normal`) times
+    /// `weight`; or, where reads are deferred, zero, the read left for later
+    /// with weight `w` times `weight` (`w`: what the radiance leaving along
+    /// the gather ray is multiplied by on its way to the camera) and its
+    /// cell's slot being fetched.
+    pub(super) fn read(
+        &self,
+        point: glam::Vec3,
+        normal: glam::Vec3,
+        weight: Color,
+        w: Color,
+        sh: &mut Shade<'_, '_, 'a>,
+    ) -> Color {
+        if weight == Color::ZERO || self.cache.is_empty() {
+            return Color::ZERO;
+        }
+        if self.settings.defer_reads {
+            self.cache.prefetch_cell(point);
+            sh.thread.pending.push(PendingRead { point, normal, weight: w * weight, ..Default::default() });
+            Color::ZERO
+        } else {
+            weight * self.lookup(point, normal, self.cache.locate(point), sh.ctx)
+        }
+    }
+
+    /// The cache's irradiance at `point` (in `cell`), from a cache point
+    /// that no surface hides from it ([`IrradianceCache::lookup_seen`]):
+    /// the shadow rays that asks for are counted.
+    pub(super) fn lookup(&self, point: glam::Vec3, normal: glam::Vec3, cell: CellRange, ctx: &mut Context) -> Color {
+        self.cache.lookup_seen(point, normal, cell, |from, to| {
+            let (dir, len) = ((to - from).normalize_or_zero(), from.distance(to));
+            ctx.counters.rays += 1;
+            ctx.counters.cache_rays += 1;
+            let blocked = self.scene.occluded(&Ray::new(from, dir), None, len, None);
+            ctx.counters.cache_hidden += blocked as u64;
+            blocked
+        })
+    }
+}
