@@ -257,24 +257,39 @@ impl Medium {
     pub fn transmittance(&self, ray: &Ray, t_max: f32, rng: &mut Rng) -> Color {
         match self.kind {
             Kind::Homogeneous { sigma_t } => exp_neg(sigma_t, t_max),
-            Kind::Heterogeneous { majorant, bbox } => {
-                let Some((t0, t1)) = bbox.clip(ray, t_max) else { return Color::ONE };
-                if !(majorant > 0.0) {
-                    return Color::ONE;
-                }
-                let mut tr = Color::ONE;
-                let mut t = t0;
-                loop {
-                    t -= (1.0 - rng.random::<f32>()).ln() / majorant;
-                    if !(t < t1) {
-                        return tr;
-                    }
-                    let sigma_t = self.sigma_t.eval(ray.at(t)) * self.scale;
-                    tr *= (Color::ONE - sigma_t / majorant).max(Color::ZERO);
-                    if tr == Color::ZERO {
-                        return tr;
-                    }
-                }
+            Kind::Heterogeneous { majorant, bbox } => self.ratio_tracking(majorant, bbox, ray, t_max, rng, |_, _| ()),
+        }
+    }
+
+    /// Ratio tracking (Novák et al. 2014) through a heterogeneous medium's
+    /// box over [0, `t_max`] of `ray`: each factor in [0, 1], `step` told
+    /// every tentative collision's distance and the transmittance up to it.
+    #[inline]
+    fn ratio_tracking(
+        &self,
+        majorant: f32,
+        bbox: Aabb,
+        ray: &Ray,
+        t_max: f32,
+        rng: &mut Rng,
+        mut step: impl FnMut(f32, Color),
+    ) -> Color {
+        let Some((t0, t1)) = bbox.clip(ray, t_max) else { return Color::ONE };
+        if !(majorant > 0.0) {
+            return Color::ONE;
+        }
+        let mut tr = Color::ONE;
+        let mut t = t0;
+        loop {
+            t -= (1.0 - rng.random::<f32>()).ln() / majorant;
+            if !(t < t1) {
+                return tr;
+            }
+            let sigma_t = self.sigma_t.eval(ray.at(t)) * self.scale;
+            tr *= (Color::ONE - sigma_t / majorant).max(Color::ZERO);
+            step(t, tr);
+            if tr == Color::ZERO {
+                return tr;
             }
         }
     }

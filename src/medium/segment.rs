@@ -7,7 +7,6 @@
 use super::{exp_neg, Kind, Medium};
 use crate::math::{Color, Ray};
 use glam::Vec2;
-use rand::RngExt;
 
 /// A segment's transmittance as a function of distance: exact in a
 /// homogeneous medium; in a heterogeneous one, ratio tracking's running
@@ -62,24 +61,7 @@ impl Medium {
                 exp_neg(sigma_t, t_max)
             }
             Kind::Heterogeneous { majorant, bbox } => {
-                let Some((t0, t1)) = bbox.clip(ray, t_max) else { return Color::ONE };
-                if !(majorant > 0.0) {
-                    return Color::ONE;
-                }
-                let mut tr = Color::ONE;
-                let mut t = t0;
-                loop {
-                    t -= (1.0 - rng.random::<f32>()).ln() / majorant;
-                    if !(t < t1) {
-                        return tr;
-                    }
-                    let sigma_t = self.sigma_t.eval(ray.at(t)) * self.scale;
-                    tr *= (Color::ONE - sigma_t / majorant).max(Color::ZERO);
-                    steps.steps.push((t, tr));
-                    if tr == Color::ZERO {
-                        return tr;
-                    }
-                }
+                self.ratio_tracking(majorant, bbox, ray, t_max, rng, |t, tr| steps.steps.push((t, tr)))
             }
         }
     }
