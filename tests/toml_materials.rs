@@ -316,7 +316,12 @@ materials = ["shiny", {{ type = "diffuse", reflectance = {{ type = "checkerboard
 
 [materials.shiny]
 type = "roughconductor"
+material = "Cu"
 alpha = 0.2
+
+[materials.coat]
+type = "plastic"
+int_ior = "water"
 
 [materials.floor]
 type = "bumpmap"
@@ -345,7 +350,7 @@ material = "floor"
 [[shapes]]
 type = "mesh"
 file = "quad.obj"
-material = "mix"
+material = "coat"
 
 [[lights]]
 type = "point"
@@ -362,7 +367,10 @@ color = [20, 20, 20]
         <float name="metallic" value="0.3"/>
         <float name="roughness" value="0.4"/>
     </bsdf>
-    <bsdf type="twosided" id="shiny"><bsdf type="roughconductor"><float name="alpha" value="0.2"/></bsdf></bsdf>
+    <bsdf type="twosided" id="shiny"><bsdf type="roughconductor">
+        <string name="material" value="Cu"/><float name="alpha" value="0.2"/>
+    </bsdf></bsdf>
+    <bsdf type="twosided" id="coat"><bsdf type="plastic"><string name="int_ior" value="water"/></bsdf></bsdf>
     <bsdf type="blendbsdf" id="mix">
         <float name="weight" value="0.3"/>
         <ref id="shiny"/>
@@ -382,7 +390,7 @@ color = [20, 20, 20]
             <bsdf type="twosided"><bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf></bsdf>
         </bsdf>
     </shape>
-    <shape type="obj"><string name="filename" value="quad.obj"/><ref id="mix"/></shape>
+    <shape type="obj"><string name="filename" value="quad.obj"/><ref id="coat"/></shape>
     <emitter type="point"><point name="position" value="0, 4, -2"/><rgb name="intensity" value="20"/></emitter>
 </scene>
 "#;
@@ -407,7 +415,19 @@ fn mistakes_in_materials_and_textures_are_located() {
     let light = "\n[[lights]]\ntype = \"point\"\nposition = [0, 4, 0]\ncolor = [1, 1, 1]\n";
     let sphere = "\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n";
     // (the material and texture tables, the line, the field, words of the message)
-    let cases: [(&str, usize, &str, &str); 8] = [
+    let cases: [(&str, usize, &str, &str); 10] = [
+        (
+            "[materials.m]\ntype = \"roughdielectric\"\nint_ior = \"unobtainium\"\n",
+            3,
+            "materials.m.int_ior",
+            "'unobtainium' is not a named index",
+        ),
+        (
+            "[materials.m]\ntype = \"conductor\"\neta = 1.2\nmaterial = \"Au\"\n",
+            4,
+            "materials.m.material",
+            "not both",
+        ),
         ("[materials.m]\ntype = \"principled\"\ncolour = [1, 0, 0]\n", 3, "materials.m.colour", "unknown field `colour`"),
         ("[materials.m]\ntype = \"principled\"\nroughness = 1.5\n", 3, "materials.m.roughness", "must lie in [0, 1], got 1.5"),
         (

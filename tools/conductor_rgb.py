@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes src/scene/mitsuba/conductors.rs: the RGB eta and k of Mitsuba 3's
+"""Writes src/material/conductors.rs: the RGB eta and k of Mitsuba 3's
 named conductors, computed from a mitsuba-data checkout's ior/*.spd files
 the way Mitsuba's RGB variants compute them.
 
@@ -18,7 +18,7 @@ Usage:
     python3 tools/conductor_rgb.py MITSUBA_DATA_DIR [OUTPUT.rs]
 
 MITSUBA_DATA_DIR holds ior/NAME.eta.spd and ior/NAME.k.spd (the
-mitsuba-data repository). OUTPUT defaults to src/scene/mitsuba/conductors.rs
+mitsuba-data repository). OUTPUT defaults to src/material/conductors.rs
 beside this tool.
 """
 
@@ -30,7 +30,7 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 CIE_RS = os.path.join(HERE, "..", "src", "scene", "mitsuba", "cie.rs")
-DEFAULT_OUT = os.path.join(HERE, "..", "src", "scene", "mitsuba", "conductors.rs")
+DEFAULT_OUT = os.path.join(HERE, "..", "src", "material", "conductors.rs")
 
 CIE_MIN, CIE_MAX, CIE_SAMPLES = 360.0, 830.0, 95
 Y_NORMALIZATION = 1.0 / 106.7502593994140625

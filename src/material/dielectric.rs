@@ -24,10 +24,6 @@ use crate::math::Color;
 use crate::optics::fresnel_dielectric;
 use glam::{Vec2, Vec3};
 
-/// Mitsuba's named indices for the defaults: "bk7" and "air".
-pub const BK7: f32 = 1.5046;
-pub const AIR: f32 = 1.000277;
-
 /// Rough glass: one glossy lobe on each side.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RoughDielectric {

@@ -42,9 +42,11 @@
 
 mod blend;
 mod conductor;
+pub mod conductors;
 mod dielectric;
 pub mod disney;
 mod glossy;
+pub mod indices;
 mod mask;
 pub mod microfacet;
 mod mitsuba;
@@ -82,10 +84,10 @@ pub mod defaults {
     /// `alpha` of the rough BSDFs.
     pub const ALPHA: f32 = 0.1;
     /// `int_ior` of the dielectrics ("bk7") and of the plastics ("polypropylene").
-    pub const DIELECTRIC_INT_IOR: f32 = super::dielectric::BK7;
-    pub const PLASTIC_INT_IOR: f32 = super::plastic::POLYPROPYLENE;
+    pub const DIELECTRIC_INT_IOR: f32 = super::indices::BK7;
+    pub const PLASTIC_INT_IOR: f32 = super::indices::POLYPROPYLENE;
     /// `ext_ior` ("air").
-    pub const EXT_IOR: f32 = super::dielectric::AIR;
+    pub const EXT_IOR: f32 = super::indices::AIR;
     /// A conductor's `eta` and `k` with no named material: a perfect mirror.
     pub const CONDUCTOR_ETA: f32 = 0.0;
     pub const CONDUCTOR_K: f32 = 1.0;

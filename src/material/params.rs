@@ -21,8 +21,12 @@ pub enum Kind {
     Signed(f32),
     /// A roughness, within [0, 10].
     Alpha,
-    /// An index of refraction, within (0, 100).
+    /// An index of refraction, within (0, 100), or its name
+    /// ([`super::indices::NAMED_IOR`]).
     Index,
+    /// A conductor's name ([`super::conductors`], or `none`), which
+    /// stands for its `eta` and `k` ([`super::indices::complex_index`]).
+    Conductor,
     /// A sampling rate: above 0.
     Rate,
     /// `true` or `false`.
@@ -83,11 +87,13 @@ use super::defaults::{CONDUCTOR_ETA, CONDUCTOR_K, DIELECTRIC_INT_IOR, DIFFUSE_RE
 /// Mitsuba's `diffuse`.
 pub const DIFFUSE: &[Spec] = &[reflectance("reflectance", 0.5)];
 pub const CONDUCTOR: &[Spec] = &[
+    spec("material", Kind::Conductor, f32::NAN, false),
     spec("eta", Kind::Color, CONDUCTOR_ETA, false),
     spec("k", Kind::Color, CONDUCTOR_K, false),
     reflectance("specular_reflectance", 1.0),
 ];
 pub const ROUGH_CONDUCTOR: &[Spec] = &[
+    spec("material", Kind::Conductor, f32::NAN, false),
     spec("eta", Kind::Color, CONDUCTOR_ETA, false),
     spec("k", Kind::Color, CONDUCTOR_K, false),
     reflectance("specular_reflectance", 1.0),

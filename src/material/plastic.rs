@@ -27,9 +27,6 @@ use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 use std::sync::Mutex;
 
-/// Polypropylene, Mitsuba's default plastic index.
-pub const POLYPROPYLENE: f32 = 1.49;
-
 /// The hemispherical (cosine-weighted) reflectance of a smooth dielectric
 /// boundary of relative index `eta` for light arriving evenly from all
 /// directions: Mitsuba's fits (Egan and Hilgeman 1973 for eta < 1, d'Eon

@@ -104,6 +104,11 @@ impl<'a> Builder<'a> {
                 let a: V3 = self.src.read(v, &field)?;
                 self.finite(&At { value: &a, span: span.clone(), field: field.clone() })?
             }
+            DeValue::String(_) if s.kind == Kind::Index => {
+                let name: String = self.src.read(v, &field)?;
+                let x = crate::material::indices::index_named(&name).map_err(|m| self.src.error(span, field, m))?;
+                return Ok(Param::Fixed(Color::splat(x)));
+            }
             DeValue::String(_) | DeValue::Table(_) if s.texture => {
                 return Ok(Param::Texture(self.texture_value(v, field)?));
             }
@@ -112,6 +117,7 @@ impl<'a> Builder<'a> {
                     (true, true) => "a colour [r, g, b], a number or a texture (its name or an inline table)",
                     (true, false) => "a colour [r, g, b] or a number",
                     (false, true) => "a number or a texture (its name or an inline table)",
+                    (false, false) if s.kind == Kind::Index => "a number or the name of an index (e.g. \"bk7\")",
                     (false, false) => "a number",
                 };
                 return self.fail(span, &field, format!("invalid type: {}, expected {what}", other.type_str()));
@@ -195,8 +201,7 @@ impl<'a> Builder<'a> {
         let recipe = match kind.as_str() {
             "diffuse" => (Textured::Diffuse { reflectance: self.param(&mut f, &spec("reflectance"))? }, false),
             "conductor" | "roughconductor" => {
-                let eta = self.fixed(&mut f, &spec("eta"))?;
-                let k = self.fixed(&mut f, &spec("k"))?;
+                let (eta, k) = self.complex_index(&mut f, specs)?;
                 let specular = self.param(&mut f, &spec("specular_reflectance"))?;
                 if kind == "conductor" {
                     (Textured::Conductor { eta, k, specular }, false)
@@ -412,6 +417,24 @@ impl<'a> Builder<'a> {
             Some(r) => Ok(r),
             None => self.fail(f.kind_span.clone(), &f.prefix, "more than 255 different sets of sampling rates"),
         }
+    }
+
+    /// A conductor's (eta, k): a named `material` or `eta` and `k`
+    /// (`material::indices::complex_index`, as the Mitsuba front-end).
+    fn complex_index(&mut self, f: &mut Fields<'a>, specs: &[Spec]) -> Result<(Color, Color), SceneError> {
+        let spec = |n: &str| params::find(specs, n).copied().unwrap_or(specs[0]);
+        let span =
+            f.items.iter().find(|(k, _)| k.get_ref() == "material").map_or(f.kind_span.clone(), |(_, v)| v.span());
+        let field = f.field("material");
+        let material = self.choice(f, &spec("material"))?;
+        let mut given = |b: &mut Self, n: &str| -> Result<Option<Color>, SceneError> {
+            if !f.has(n) {
+                return Ok(None);
+            }
+            b.fixed(f, &spec(n)).map(Some)
+        };
+        let (eta, k) = (given(self, "eta")?, given(self, "k")?);
+        crate::material::indices::complex_index(material.as_deref(), eta, k).map_err(|m| self.src.error(span, field, m))
     }
 
     /// The interior and exterior indices, which must differ where an

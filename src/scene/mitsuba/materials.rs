@@ -5,8 +5,9 @@
 //! diffuse reflectance of 0.5.
 
 use super::props::Plugin;
-use super::spectrum::{named_ior, Use};
+use super::spectrum::Use;
 use super::Builder;
+use crate::material::indices;
 use crate::material::params::{self, Spec};
 use crate::material::{Distribution, Material, Param, Textured};
 use crate::math::Color;
@@ -154,8 +155,8 @@ impl Builder<'_> {
                 }
             }
             "dielectric" => {
-                let int = ior(p, "int_ior", "bk7")?;
-                let ext = ior(p, "ext_ior", "air")?;
+                let int = ior(p, params::ROUGH_DIELECTRIC, "int_ior")?;
+                let ext = ior(p, params::ROUGH_DIELECTRIC, "ext_ior")?;
                 for name in ["specular_reflectance", "specular_transmittance"] {
                     if let Some(c) = p.color(name, Use::Reflectance)? {
                         if c != Color::ONE {
@@ -186,7 +187,8 @@ impl Builder<'_> {
                 }
             }
             "roughdielectric" | "thindielectric" => {
-                let (int, ext) = (ior(p, "int_ior", "bk7")?, ior(p, "ext_ior", "air")?);
+                let dielectric = params::ROUGH_DIELECTRIC;
+                let (int, ext) = (ior(p, dielectric, "int_ior")?, ior(p, dielectric, "ext_ior")?);
                 if int == ext {
                     return Err(p.refuse("the interior and exterior indices of refraction must differ"));
                 }
@@ -211,7 +213,7 @@ impl Builder<'_> {
                 )
             }
             "plastic" | "roughplastic" => {
-                let (int, ext) = (ior(p, "int_ior", "polypropylene")?, ior(p, "ext_ior", "air")?);
+                let (int, ext) = (ior(p, params::PLASTIC, "int_ior")?, ior(p, params::PLASTIC, "ext_ior")?);
                 if int == ext {
                     return Err(p.refuse("the interior and exterior indices of refraction must differ"));
                 }
@@ -343,37 +345,31 @@ impl Builder<'_> {
     }
 }
 
-/// An index of refraction: a number or a name from Mitsuba's table.
-fn ior(p: &Plugin, name: &str, default: &str) -> Result<f64, SceneError> {
+/// An index of refraction by its definition in `list`: a number in its
+/// range or a name from Mitsuba's table (`material::indices`), else the
+/// definition's default. Read as a double, as Mitsuba reads it: smooth
+/// glass takes the ratio of two.
+fn ior(p: &Plugin, list: &[Spec], name: &str) -> Result<f64, SceneError> {
+    let spec = params::find(list, name).expect("an index the list defines");
     if p.tag_of(name) == Some("string") {
         let (text, loc) = p.string(name)?.expect("a string, looked at");
-        return named_ior(&text).map(|v| v as f64).ok_or_else(|| {
-            p.fail(&loc, name, format!("'{text}' is not a named index of refraction (e.g. bk7, water, air, diamond)"))
-        });
+        return indices::index_named(&text).map(|v| v as f64).map_err(|m| p.fail(&loc, name, m));
     }
-    let v = match p.float(name)? {
-        Some(v) => v,
-        None => named_ior(default).expect("a default from the table") as f64,
-    };
-    if !(v > 0.0 && v < 100.0) {
-        return Err(p.fail(p.loc(), name, format!("must lie in (0, 100), got {v}")));
-    }
+    let v = p.float(name)?.unwrap_or(spec.default as f64);
+    spec.check(Color::splat(v as f32)).map_err(|m| p.fail(&p.named_loc(name), name, m))?;
     Ok(v)
 }
 
 /// A conductor's complex index: `eta` and `k`, or a named `material`
-/// (conductors.rs; 'none': a perfect mirror, eta 0 + 1i).
+/// (`material::indices::complex_index`, shared with the TOML reader).
 fn complex_ior(p: &Plugin) -> Result<(Color, Color), SceneError> {
-    let eta = p.color("eta", Use::Unbounded)?;
-    let k = p.color("k", Use::Unbounded)?;
+    let value = |name: &str| -> Result<Option<Color>, SceneError> {
+        let Some(c) = p.color(name, Use::Unbounded)? else { return Ok(None) };
+        let spec = params::find(params::CONDUCTOR, name).expect("eta and k are defined");
+        spec.check(c).map(Some).map_err(|m| p.fail(&p.named_loc(name), name, m))
+    };
+    let (eta, k) = (value("eta")?, value("k")?);
     let material = p.string("material")?;
-    match (material, eta, k) {
-        (Some((m, loc)), Some(_), _) | (Some((m, loc)), _, Some(_)) if m != "none" => {
-            Err(p.fail(&loc, "material", format!("give either eta and k or a material ('{m}'), not both")))
-        }
-        (Some((m, loc)), None, None) if m != "none" => super::conductors::named_conductor(&m).ok_or_else(|| {
-            p.fail(&loc, "material", format!("'{m}' is not a conductor Mitsuba names (e.g. Au, Ag, Al, Cu, Cr)"))
-        }),
-        (_, eta, k) => Ok((eta.unwrap_or(Color::ZERO), k.unwrap_or(Color::ONE))),
-    }
+    let loc = material.as_ref().map_or_else(|| p.loc().clone(), |(_, l)| l.clone());
+    indices::complex_index(material.as_ref().map(|(m, _)| m.as_str()), eta, k).map_err(|m| p.fail(&loc, "material", m))
 }

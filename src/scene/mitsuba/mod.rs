@@ -18,7 +18,6 @@
 //! [`Imported::substitutions`].
 
 pub mod cie;
-pub mod conductors;
 mod emitters;
 mod film;
 mod materials;

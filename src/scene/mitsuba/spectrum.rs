@@ -105,39 +105,6 @@ pub fn pairs_to_rgb(wavelengths: &[f64], values: &[f64], usage: Use) -> (Color, 
     (Color::new(c[0], c[1], c[2]), clamped)
 }
 
-/// Named indices of refraction, as Mitsuba 3's `dielectric` documentation
-/// lists them (values at about 589 nm; they are the usual handbook figures,
-/// e.g. the CRC Handbook of Chemistry and Physics and Schott's BK7 sheet).
-pub const NAMED_IOR: [(&str, f32); 23] = [
-    ("vacuum", 1.0),
-    ("helium", 1.000036),
-    ("hydrogen", 1.000132),
-    ("air", 1.000277),
-    ("carbon dioxide", 1.00045),
-    ("water", 1.3330),
-    ("acetone", 1.36),
-    ("ethanol", 1.361),
-    ("carbon tetrachloride", 1.461),
-    ("glycerol", 1.4729),
-    ("benzene", 1.501),
-    ("silicone oil", 1.52045),
-    ("bromine", 1.661),
-    ("water ice", 1.31),
-    ("fused quartz", 1.458),
-    ("pyrex", 1.470),
-    ("acrylic glass", 1.49),
-    ("polypropylene", 1.49),
-    ("bk7", 1.5046),
-    ("sodium chloride", 1.544),
-    ("amber", 1.55),
-    ("pet", 1.5750),
-    ("diamond", 2.419),
-];
-
-pub fn named_ior(name: &str) -> Option<f32> {
-    NAMED_IOR.iter().find(|(n, _)| n.eq_ignore_ascii_case(name)).map(|&(_, v)| v)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -167,12 +134,5 @@ mod tests {
         assert!(red.x > 5.0 * red.y.max(0.0) && red.x > red.z, "{red}");
         let (blue, _) = pairs_to_rgb(&[440.0, 450.0, 460.0], &[0.0, 1.0, 0.0], Use::Emission);
         assert!(blue.z > blue.x && blue.z > blue.y, "{blue}");
-    }
-
-    #[test]
-    fn named_indices_are_found_in_any_case() {
-        assert_eq!(named_ior("BK7"), Some(1.5046));
-        assert_eq!(named_ior("water"), Some(1.333));
-        assert_eq!(named_ior("unobtainium"), None);
     }
 }
