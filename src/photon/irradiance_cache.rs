@@ -83,11 +83,23 @@ impl CachePoint {
     /// them ([`in_front`]).
     #[inline]
     fn answers(&self, x: Vec3, n: Vec3, d2: f32) -> bool {
+        self.faces(n) & self.in_front_of(x, n, d2)
+    }
+
+    /// Whether the point lies on a surface facing like `n`.
+    #[inline(always)]
+    fn faces(&self, n: Vec3) -> bool {
+        normal_times_127(self.normal).dot(n) >= 127.0 * NORMAL_COSINE
+    }
+
+    /// Whether no surface lies between the point and `x` (squared distance
+    /// `d2`), on a surface facing `n` ([`in_front`]).
+    #[inline(always)]
+    fn in_front_of(&self, x: Vec3, n: Vec3, d2: f32) -> bool {
         // Both normals 127 times as long, the distance too ([`in_front`]
         // asks for ratios): no division for the stored normal's unit.
         const S: f32 = 127.0;
-        let m = normal_times_127(self.normal);
-        (m.dot(n) >= S * NORMAL_COSINE) & in_front(x, S * n, Vec3::from(self.position), m, S * S * d2)
+        in_front(x, S * n, Vec3::from(self.position), normal_times_127(self.normal), S * S * d2)
     }
 
     fn normal(&self) -> Vec3 {
@@ -335,7 +347,7 @@ impl IrradianceCache {
 
     /// Finds `x`'s cell (after [`Self::prefetch_cell`] had time to bring in
     /// its slot) and starts fetching its points, for [`Self::lookup_in`].
-    #[inline]
+    #[inline(always)]
     pub fn locate(&self, x: Vec3) -> CellRange {
         let range = self.cells.range(x);
         if let Some((start, end)) = range {
@@ -364,7 +376,7 @@ impl IrradianceCache {
 
     /// [`Self::lookup`] with `x`'s cell already found by [`Self::locate`].
     pub fn lookup_in(&self, x: Vec3, n: Vec3, cell: CellRange) -> Color {
-        self.nearest(x, n, cell, &[]).map_or(Color::ZERO, |i| self.irradiance(i))
+        self.lookup_seen(x, n, cell, |_, _| false)
     }
 
     /// [`Self::lookup_in`] where a surface may lie between `x` and the
@@ -376,10 +388,45 @@ impl IrradianceCache {
     /// other's surface two points lie, but not what lies between at a
     /// grazing angle: from inside a small closed object, the wall beside
     /// it (a lookup reaches up to twice the radius cap).
-    pub fn lookup_seen(&self, x: Vec3, n: Vec3, cell: CellRange, mut blocked: impl FnMut(Vec3, Vec3) -> bool) -> Color {
+    ///
+    /// Nearly every lookup is answered by the nearest point that faces
+    /// alike, which lies in front and at `x`'s level: that point is found
+    /// first, as the plain facing test finds it, and the side and level
+    /// tests are asked of it alone (the nearest point that answers is the
+    /// same wherever it passes them); only where it fails are they asked
+    /// of every candidate ([`Self::lookup_hidden`]). Asked of every
+    /// candidate, they took the default command's lookups from 11% of its
+    /// time to 15% (a profile, 2-core AMD EPYC VM).
+    #[inline]
+    pub fn lookup_seen(&self, x: Vec3, n: Vec3, cell: CellRange, blocked: impl FnMut(Vec3, Vec3) -> bool) -> Color {
+        let Some(i) = self.nearest(x, n, cell, |p, _, _| p.faces(n)) else {
+            // None faces alike: none answers.
+            return Color::ZERO;
+        };
+        let p = &self.points[i as usize];
+        let d = Vec3::from(p.position) - x;
+        let d2 = d.length_squared();
+        // The level test's first condition ([`Self::level_apart`]) from the
+        // plane distances, with a margin for their rounding.
+        let (a, b) = (n.dot(d), normal_times_127(p.normal).dot(d) * (1.0 / 127.0));
+        let level = !(a * b > 0.0 && a.abs().min(b.abs()).powi(2) > 0.9 * OFF_PLANE * OFF_PLANE * d2);
+        if p.in_front_of(x, n, d2) && (level || self.level_apart(x, n, i).is_none()) {
+            return self.irradiance(i);
+        }
+        self.lookup_hidden(x, n, cell, blocked)
+    }
+
+    /// [`Self::lookup_seen`] where the nearest point facing alike lies
+    /// behind `x`'s surface or at another level.
+    #[cold]
+    #[inline(never)]
+    fn lookup_hidden(&self, x: Vec3, n: Vec3, cell: CellRange, mut blocked: impl FnMut(Vec3, Vec3) -> bool) -> Color {
         let mut hidden = [u32::MAX; MAX_HIDDEN];
         for h in 0..=MAX_HIDDEN {
-            let Some(i) = self.nearest(x, n, cell, &hidden[..h]) else { break };
+            let hidden_now = &hidden[..h];
+            let Some(i) = self.nearest(x, n, cell, |p, i, d2| p.answers(x, n, d2) && !hidden_now.contains(&i)) else {
+                break;
+            };
             match self.level_apart(x, n, i) {
                 Some((from, to)) if blocked(from, to) => {
                     if h < MAX_HIDDEN {
@@ -427,16 +474,24 @@ impl IrradianceCache {
         Some((x + lift * n, p + lift * m))
     }
 
-    /// The cache point that answers a lookup at `x` on a surface facing
-    /// `n` ([`Self::lookup`]), but none of `hidden`.
-    #[inline]
-    fn nearest(&self, x: Vec3, n: Vec3, cell: CellRange, hidden: &[u32]) -> Option<u32> {
+    /// The cache point nearest a lookup at `x` on a surface facing `n`,
+    /// relative to its reach ([`Self::lookup`]), of those that `accept`
+    /// (the point, its index, its squared distance to `x`); the points
+    /// accepted must face like `n`.
+    #[inline(always)]
+    fn nearest(
+        &self,
+        x: Vec3,
+        n: Vec3,
+        cell: CellRange,
+        accept: impl Fn(&CachePoint, u32, f32) -> bool,
+    ) -> Option<u32> {
         if let Some((start, end)) = cell.0 {
             let mut best: Option<(f32, u32)> = None;
             for (i, p) in (start..end).zip(&self.points[start as usize..end as usize]) {
                 let d2 = Vec3::from(p.position).distance_squared(x);
                 let q = d2 * p.inv_reach2;
-                if q <= 1.0 && best.is_none_or(|b| q < b.0) && p.answers(x, n, d2) && !hidden.contains(&i) {
+                if q <= 1.0 && best.is_none_or(|b| q < b.0) && accept(p, i, d2) {
                     best = Some((q, i));
                 }
             }
@@ -460,11 +515,7 @@ impl IrradianceCache {
                     let p = &self.points[i as usize];
                     let d2 = Vec3::from(p.position).distance_squared(x);
                     let q = d2 * p.inv_reach2;
-                    if q <= 1.0
-                        && best.is_none_or(|b| q < b.0 || (q == b.0 && i < b.1))
-                        && p.answers(x, n, d2)
-                        && !hidden.contains(&i)
-                    {
+                    if q <= 1.0 && best.is_none_or(|b| q < b.0 || (q == b.0 && i < b.1)) && accept(p, i, d2) {
                         best = Some((q, i));
                     }
                 });
