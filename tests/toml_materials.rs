@@ -508,3 +508,81 @@ fn trace_refuses_the_materials_it_cannot_render() {
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_trace")).args([&path, &out]).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// A textured ellipsoid reads its texture as Mitsuba's sphere under the
+/// same transform, and keeps its coordinates through the export: exactly
+/// where the transform scales evenly (written as a `sphere` with its
+/// `to_world`, turned here), interpolated between the vertices of the
+/// tessellation where it does not.
+#[test]
+fn a_textured_ellipsoid_keeps_its_coordinates_through_the_export() {
+    let dir = scratch_dir("toml_materials_ellipsoid");
+    let toml = r#"
+[camera]
+eye = [0, 0.5, -5]
+target = [0, 0.5, 0]
+up = [0, 1, 0]
+vfov = 40
+width = 64
+height = 48
+
+[materials.checks]
+type = "diffuse"
+reflectance = { type = "checkerboard", color0 = 0.9, color1 = 0.1, to_uv = [{ scale = [8, 4, 1] }] }
+
+[[shapes]]
+type = "ellipsoid"
+transform = [{ rotate = { axis = [1, 1, 0], degrees = 40 } }, { scale = [0.8, 0.8, 0.8] }, { translate = [-0.9, 0.5, 0] }]
+material = "checks"
+
+[[shapes]]
+type = "ellipsoid"
+transform = [{ scale = [0.5, 0.9, 0.7] }, { rotate = { axis = [0, 1, 1], degrees = 25 } }, { translate = [0.9, 0.5, 0] }]
+material = "checks"
+
+[[lights]]
+type = "point"
+position = [0, 3, -4]
+color = [30, 30, 30]
+"#;
+    let path = dir.join("ellipsoids.toml");
+    std::fs::write(&path, toml).unwrap();
+    let file = photonmap::scene::file::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let exported =
+        to_mitsuba(&file.parts, Some(&file.origins), "ell-meshes", Placement::new(glam::Vec3::ZERO, 1.0).unwrap())
+            .unwrap_or_else(|e| panic!("{}", e.describe(Some(&file.origins))));
+    assert!(exported.xml.contains("<shape type=\"sphere\">") && exported.xml.contains("name=\"to_world\""));
+    assert_eq!(exported.meshes.len(), 1, "the uneven one is a mesh");
+    assert!(String::from_utf8_lossy(&exported.meshes[0].1).contains("property float u\n"), "with coordinates");
+    std::fs::create_dir_all(dir.join("ell-meshes")).unwrap();
+    for (name, bytes) in &exported.meshes {
+        std::fs::write(dir.join(name), bytes).unwrap();
+    }
+    std::fs::write(dir.join("ellipsoids.xml"), &exported.xml).unwrap();
+    let mut back = read_xml(&dir.join("ellipsoids.xml"));
+    back.camera = file.parts.camera;
+    let (a, b) = (Scene::from_parts(file.parts), Scene::from_parts(back));
+    let s = Settings { gather_rays: 0, ..settings(&a) };
+    let (fa, fb) = (render_quiet(&a, &s), render_quiet(&b, &s));
+    // Pixels of each half (each ellipsoid) that differ by more than 10%
+    // of the brighter check's image.
+    let bright = fa.pixels.iter().map(|p| p.max_element()).fold(0.0f32, f32::max);
+    let mut off = [0usize; 2];
+    let mut checks = [(0usize, 0usize); 2];
+    for (i, (p, q)) in fa.pixels.iter().zip(&fb.pixels).enumerate() {
+        let half = usize::from(i as u32 % fa.width >= fa.width / 2);
+        off[half] += usize::from((*p - *q).abs().max_element() > 0.1 * bright);
+        let v = p.max_element();
+        if v > 0.4 * bright {
+            checks[half].0 += 1;
+        } else if v > 0.01 * bright {
+            checks[half].1 += 1;
+        }
+    }
+    println!("differing {off:?}, light/dark {checks:?}");
+    // Both ellipsoids show their checks (light and dark squares)...
+    assert!(checks.iter().all(|&(l, d)| l > 20 && d > 20), "{checks:?}");
+    // ... at the same places: exactly for the sphere (but a check's edge
+    // through a pixel centre), within the tessellation's error otherwise.
+    assert!(off[0] <= 3 && off[1] <= 30, "pixels differing per ellipsoid: {off:?}");
+}

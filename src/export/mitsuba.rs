@@ -8,7 +8,7 @@
 //! | camera (corners or look-at) | `perspective`, off-centre by `principal_point_offset_x/y`; a thin lens as `thinlens`, an orthographic camera as `orthographic` (module `mitsuba_sensor`); a plane that is not a rectangle of square pixels, a mirrored one, or an off-centre thin lens is refused |
 //! | triangles, meshes, tetrahedra, the room | `ply` meshes (vertex normals where the mesh is smooth, `face_normals` otherwise) |
 //! | sphere, disk | `sphere`, `disk` (by transform) |
-//! | ellipsoid | `sphere` when the transform scales evenly; else a 20,480-triangle `ply` with exact normals at its vertices (Mitsuba's sphere takes no uneven scale), and a note says so |
+//! | ellipsoid | `sphere` when the transform scales evenly (with its `to_world` where it turns or mirrors: the same texture coordinates); else a 20,480-triangle `ply` with exact normals at its vertices (Mitsuba's sphere takes no uneven scale), in a textured scene with the sphere's coordinates at them (interpolated between), and a note says so |
 //! | lambertian, mirror | `twosided` `diffuse`, `twosided` `conductor` (photonmap's are two-sided) |
 //! | glass | `dielectric`; absorption as a `homogeneous` interior medium (then `volpath`) |
 //! | disk and triangle lights | `area` emitters (one-sided) on `disk` and `ply` shapes |
@@ -227,7 +227,7 @@ pub fn to_mitsuba(
                 disk_transform(at(d.center), d.normal, d.radius * s),
                 refs(p.material)?
             ),
-            Shape::Ellipsoid(e) => out.ellipsoid(e, &refs(p.material)?),
+            Shape::Ellipsoid(e) => out.ellipsoid(e, &refs(p.material)?, parts.texturing.is_used()),
             Shape::Cylinder(c) => format!(
                 "    <shape type=\"cylinder\">\n        <point name=\"p0\" value=\"{}\"/>\n        <point name=\"p1\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{}\"/>\n        <boolean name=\"flip_normals\" value=\"{}\"/>\n{}    </shape>\n",
                 xyz(at(c.p0)),
@@ -377,9 +377,12 @@ impl Exporter<'_> {
         format!("    <shape type=\"ply\">\n        <string name=\"filename\" value=\"{name}\"/>\n{face_normals}{refs}{emitter}    </shape>\n")
     }
 
-    /// An ellipsoid: a `sphere` when its transform scales evenly, else a
-    /// tessellation with the ellipsoid's own normals at its vertices.
-    fn ellipsoid(&mut self, e: &Ellipsoid, refs: &str) -> String {
+    /// An ellipsoid: a `sphere` when its transform scales evenly (with
+    /// its `to_world` where it also turns or mirrors, so that its texture
+    /// coordinates are the same), else a tessellation with the
+    /// ellipsoid's own normals at its vertices, and, in a scene that reads
+    /// textures (`uv`), the sphere's coordinates there.
+    fn ellipsoid(&mut self, e: &Ellipsoid, refs: &str, uv: bool) -> String {
         let p = self.placement;
         let m = Affine3A::from_scale(Vec3::splat(p.scale)) * Affine3A::from_translation(-p.origin) * e.to_world();
         let cols = [m.matrix3.x_axis, m.matrix3.y_axis, m.matrix3.z_axis];
@@ -387,15 +390,21 @@ impl Exporter<'_> {
         let even = cols.iter().all(|c| (c.length() - s).abs() <= 1e-5 * s)
             && (cols[0].dot(cols[1]).abs() + cols[1].dot(cols[2]).abs() + cols[0].dot(cols[2]).abs()) <= 1e-5 * s * s;
         let flip = if e.is_flipped() { "        <boolean name=\"flip_normals\" value=\"true\"/>\n" } else { "" };
-        if even {
+        let plain =
+            m.matrix3 == glam::Mat3A::from_diagonal(Vec3::splat(m.matrix3.x_axis.x)) && m.matrix3.x_axis.x > 0.0;
+        if even && plain {
             return format!(
-                "    <shape type=\"sphere\">\n        <point name=\"center\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{s}\"/>\n{flip}{refs}    </shape>\n",
-                xyz(Vec3::from(m.translation))
+                "    <shape type=\"sphere\">\n        <point name=\"center\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{}\"/>\n{flip}{refs}    </shape>\n",
+                xyz(Vec3::from(m.translation)),
+                s
             );
+        }
+        if even {
+            return format!("    <shape type=\"sphere\">\n        {}\n{flip}{refs}    </shape>\n", matrix(&m));
         }
         let normal_map = m.matrix3.inverse().transpose();
         let sphere = icosphere(5);
-        let mut mesh = PlyMesh::new(true);
+        let mut mesh = if uv { PlyMesh::textured(true) } else { PlyMesh::new(true) };
         let sign = if e.is_flipped() { -1.0 } else { 1.0 };
         for f in &sphere.faces {
             // Flipped: wound the other way, normals inwards.
@@ -403,7 +412,7 @@ impl Exporter<'_> {
             let p = f.map(|i| m.transform_point3(sphere.positions[i as usize]));
             let n =
                 f.map(|i| sign * Vec3::from(normal_map * glam::Vec3A::from(sphere.normals[i as usize])).normalize());
-            mesh.push(p, n);
+            mesh.push_uv(p, n, sphere_uvs(f.map(|i| sphere.positions[i as usize])));
         }
         self.notes.push(format!(
             "an ellipsoid (unevenly scaled sphere) is written as a {}-triangle mesh with its exact normals at the \
@@ -412,6 +421,34 @@ impl Exporter<'_> {
         ));
         self.mesh(mesh, refs, "")
     }
+}
+
+/// Mitsuba's sphere coordinates (as `texture::SurfaceUv::Sphere`) at a
+/// triangle's corners on the unit sphere, interpolated across it: a
+/// triangle across the seam at u = 0 takes its corners' u past 1, a corner
+/// at a pole (where u is undefined) the mean u of the other two.
+fn sphere_uvs(corners: [Vec3; 3]) -> [Vec2; 3] {
+    use std::f32::consts::PI;
+    let mut uv = corners.map(|p| {
+        let u = p.y.atan2(p.x) / (2.0 * PI);
+        Vec2::new(if u < 0.0 { u + 1.0 } else { u }, p.z.clamp(-1.0, 1.0).acos() / PI)
+    });
+    let pole = corners.map(|p| p.x.abs() < 1e-6 && p.y.abs() < 1e-6);
+    let us = || (0..3).filter(|&k| !pole[k]).map(|k| uv[k].x);
+    if us().fold(f32::MIN, f32::max) - us().fold(f32::MAX, f32::min) > 0.5 {
+        for k in 0..3 {
+            if !pole[k] && uv[k].x < 0.5 {
+                uv[k].x += 1.0;
+            }
+        }
+    }
+    for k in 0..3 {
+        if pole[k] {
+            let others: Vec<f32> = (0..3).filter(|&j| !pole[j]).map(|j| uv[j].x).collect();
+            uv[k].x = others.iter().sum::<f32>() / others.len().max(1) as f32;
+        }
+    }
+    uv
 }
 
 /// References to material `m`'s BSDF and, for absorbing glass, its

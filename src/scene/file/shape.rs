@@ -213,6 +213,8 @@ impl Builder<'_> {
                 let m = self.transform(&f("transform"), &d.transform)?;
                 let e = Ellipsoid::new(m)
                     .ok_or_else(|| self.src.error(kind_span.clone(), f("transform"), "the transform is singular"))?;
+                // Textured as Mitsuba's sphere under the same transform.
+                self.surface(self.prims.len(), super::texture::ellipsoid_frame(&e), SurfaceUv::Sphere);
                 self.prims.push(Prim { shape: Shape::Ellipsoid(e), material, object });
             }
             "tetrahedron" => {

@@ -135,7 +135,19 @@ impl<'a> Builder<'a> {
 /// A disk's frame: Mitsuba's unit disk (normal +z) placed as the Mitsuba
 /// export writes it.
 pub(super) fn disk_frame(d: &crate::shape::Disk) -> DAffine3 {
-    let m = d.to_world();
+    written_affine(&d.to_world())
+}
+
+/// An ellipsoid's frame: Mitsuba's unit sphere under the transform the
+/// Mitsuba export writes (`to_world`, or centre and radius where it only
+/// moves and scales), so that its texture coordinates are a `sphere`'s.
+pub(super) fn ellipsoid_frame(e: &crate::shape::Ellipsoid) -> DAffine3 {
+    written_affine(&e.to_world())
+}
+
+/// A transform as the Mitsuba export writes it (`export::mitsuba::matrix`)
+/// and the Mitsuba front-end reads it back.
+fn written_affine(m: &glam::Affine3A) -> DAffine3 {
     let col = |v: glam::Vec3A| DVec3::new(written(v.x), written(v.y), written(v.z));
     DAffine3 {
         matrix3: glam::DMat3::from_cols(col(m.matrix3.x_axis), col(m.matrix3.y_axis), col(m.matrix3.z_axis)),
