@@ -41,6 +41,8 @@ pub enum Kind {
     Materials,
     /// A file name (relative to the scene file).
     File,
+    /// A name (a mesh attribute's: `vertex_…` or `face_…`).
+    Name,
     /// A transform (a texture's `to_uv`: its 2D part).
     Transform,
 }
@@ -207,6 +209,22 @@ pub const CHECKERBOARD: &[Spec] = &[
     spec("color1", Kind::Color, 0.2, false),
     spec("to_uv", Kind::Transform, f32::NAN, false),
 ];
+
+/// Mitsuba's `mesh_attribute` (mesh_attribute.cpp): a mesh's vertex or
+/// face attribute (`vertex_color`, `face_color`, … from a PLY file) times
+/// `scale`.
+pub const MESH_ATTRIBUTE: &[Spec] =
+    &[spec("name", Kind::Name, f32::NAN, false), spec("scale", Kind::Signed(1e30), 1.0, false)];
+
+/// Whether `name` names a mesh attribute (`vertex_…` or `face_…`), else
+/// what is wrong.
+pub fn attribute_name(name: &str) -> Result<(), String> {
+    if name.starts_with("vertex_") || name.starts_with("face_") {
+        Ok(())
+    } else {
+        Err(format!("'{name}' must start with vertex_ or face_"))
+    }
+}
 
 /// The parameters of material type `kind` (Mitsuba's plugin name), or
 /// `None` for a type not defined here.

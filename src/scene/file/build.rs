@@ -35,6 +35,8 @@ pub fn build<'i>(src: Source<'i>, def: FileDef<'i>) -> Result<SceneFile, SceneEr
         pending_textures: BTreeMap::new(),
         surfaces: Vec::new(),
         frames: Vec::new(),
+        attribute_textures: Vec::new(),
+        mesh_attributes: BTreeMap::new(),
     }
     .build(def)
 }
@@ -66,6 +68,11 @@ pub(super) struct Builder<'a> {
     /// its barycentrics), and the analytic shapes' frames they name.
     pub(super) surfaces: Vec<crate::texture::SurfaceUv>,
     pub(super) frames: Vec<glam::Affine3A>,
+    /// The `mesh_attribute` textures (index, attribute, scale), filled
+    /// once every mesh is read, from the meshes' attributes by name: per
+    /// primitive, its three corners' values.
+    pub(super) attribute_textures: Vec<(u32, String, f32)>,
+    pub(super) mesh_attributes: BTreeMap<String, Vec<(usize, [Color; 3])>>,
 }
 
 /// A value with its span and its place in the file, for checks.
@@ -165,6 +172,16 @@ impl<'a> Builder<'a> {
             let (prims, lights) = (self.prims.len(), self.lights.len());
             self.shape(i, s)?;
             self.bind_media(interface, prims, lights);
+        }
+        // A primitive without the attribute reads zero (as the Mitsuba
+        // front-end's).
+        for (index, name, scale) in std::mem::take(&mut self.attribute_textures) {
+            let mut values = vec![[Color::ZERO; 3]; self.prims.len()];
+            for &(prim, c) in self.mesh_attributes.get(&name).into_iter().flatten() {
+                values[prim] = c;
+            }
+            let values = std::sync::Arc::new(values);
+            self.textures[index as usize] = crate::texture::Texture::Attribute { values, scale };
         }
         for (i, l) in def.lights.into_iter().enumerate() {
             let place = self.place(l.kind.span(), format!("lights[{i}]"));

@@ -25,7 +25,7 @@ struct Polygon {
     vertices: Spanned<Vec<V3>>,
 }
 
-/// `type = "mesh"`: an OBJ file's triangles, transformed.
+/// `type = "mesh"`: an OBJ or PLY file's triangles, transformed.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Mesh {
@@ -167,7 +167,10 @@ impl Builder<'_> {
                 let file = at(&d.file, f("file"));
                 let m = self.transform(&f("transform"), &d.transform)?;
                 let obj_path = self.src.path.parent().unwrap_or(Path::new(".")).join(file.value);
-                let mesh = load_obj(&obj_path).map_err(|e| self.src.error(file.span.clone(), file.field.clone(), e))?;
+                let ply = obj_path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply"));
+                let (mesh, attributes) =
+                    if ply { ply_mesh(&obj_path) } else { load_obj(&obj_path).map(|m| (m, Vec::new())) }
+                        .map_err(|e| self.src.error(file.span.clone(), file.field.clone(), e))?;
                 self.meshes.push(obj_path.clone());
                 let triangles: Vec<Triangle> = mesh
                     .triangles
@@ -191,12 +194,19 @@ impl Builder<'_> {
                         .collect::<Vec<_>>()
                 });
                 // Texture coordinates as Mitsuba reads an OBJ's: v from the
-                // bottom of the image (obj.cpp's flip_tex_coords).
-                let uvs = mesh
-                    .uvs
-                    .map(|uvs| uvs.iter().map(|t| t.map(|uv| glam::Vec2::new(uv.x, 1.0 - uv.y))).collect::<Vec<_>>());
+                // bottom of the image (obj.cpp's flip_tex_coords); a PLY's
+                // as they are.
+                let flip = |uv: glam::Vec2| if ply { uv } else { glam::Vec2::new(uv.x, 1.0 - uv.y) };
+                let uvs = mesh.uvs.map(|uvs| uvs.iter().map(|t| t.map(flip)).collect::<Vec<_>>());
                 let corners = (normals.as_deref(), uvs.as_deref());
-                self.triangles(i, &d.material, emission, &triangles, corners, kind_span)?;
+                let first = self.prims.len();
+                let kept = self.triangles(i, &d.material, emission, &triangles, corners, kind_span)?;
+                if emission.is_none() {
+                    for (name, values) in attributes {
+                        let prims = kept.iter().enumerate().map(|(k, &j)| (first + k, values[j]));
+                        self.mesh_attributes.entry(name).or_default().extend(prims);
+                    }
+                }
             }
             "sphere" => {
                 let d: SphereDef = self.read_shape(&mut entry)?;
@@ -297,8 +307,9 @@ impl Builder<'_> {
         triangles: &[Triangle],
         (normals, uvs): Corners,
         span: Range<usize>,
-    ) -> Result<(), SceneError> {
+    ) -> Result<Vec<usize>, SceneError> {
         let mut kept = Vec::with_capacity(triangles.len());
+        let mut kept_at = Vec::with_capacity(triangles.len());
         let mut kept_uvs = Vec::new();
         for (j, t) in triangles.iter().enumerate() {
             if !(t.area() > 0.0 && t.normal.is_finite()) {
@@ -310,6 +321,7 @@ impl Builder<'_> {
                 self.shading_normals.push(n);
             }
             kept.push(t);
+            kept_at.push(j);
             if let Some(uvs) = uvs {
                 kept_uvs.push(uvs[j]);
             }
@@ -345,6 +357,41 @@ impl Builder<'_> {
                 self.prims.extend(kept.into_iter().map(|t| Prim { shape: Shape::Triangle(t), material, object }));
             }
         }
-        Ok(())
+        Ok(kept_at)
     }
+}
+
+/// A PLY file's triangles (with their vertex normals, turned to the side
+/// of the winding, and texture coordinates where it has them), and its
+/// attributes per triangle's corners (a face's value at all three), named
+/// as Mitsuba names them (`vertex_color`, `face_color`, …).
+type Attributes = Vec<(String, Vec<[Color; 3]>)>;
+fn ply_mesh(path: &std::path::Path) -> Result<(crate::scene::mesh::ObjMesh, Attributes), String> {
+    let m = crate::scene::ply::load_ply(path)?;
+    let triangles: Vec<[Vec3; 3]> = m.triangles.iter().map(|t| t.map(|i| m.positions[i as usize])).collect();
+    let normals = m.normals.as_ref().map(|n| {
+        m.triangles
+            .iter()
+            .zip(&triangles)
+            .map(|(t, v)| {
+                let c = t.map(|i| n[i as usize].normalize_or_zero());
+                let face = (v[1] - v[0]).cross(v[2] - v[0]);
+                if (c[0] + c[1] + c[2]).dot(face) < 0.0 {
+                    c.map(|x| -x)
+                } else {
+                    c
+                }
+            })
+            .collect()
+    });
+    let uvs = m.uvs.as_ref().map(|uv| m.triangles.iter().map(|t| t.map(|i| uv[i as usize])).collect());
+    let attributes = m
+        .attributes
+        .iter()
+        .map(|a| {
+            let at = |f: usize, t: &[u32; 3]| if a.per_face { [a.color(f); 3] } else { t.map(|i| a.color(i as usize)) };
+            (a.name.clone(), m.triangles.iter().enumerate().map(|(f, t)| at(f, t)).collect())
+        })
+        .collect();
+    Ok((crate::scene::mesh::ObjMesh { triangles, normals, uvs }, attributes))
 }

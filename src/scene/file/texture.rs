@@ -1,5 +1,6 @@
 //! `[textures.NAME]` and the textures written inline where a material's
-//! parameter takes one: `bitmap` and `checkerboard`, with the fields
+//! parameter takes one: `bitmap`, `checkerboard` and `mesh_attribute`
+//! (a PLY mesh's vertex or face colours), with the fields
 //! `material::params` defines for both front-ends (Mitsuba 3's names,
 //! meanings and defaults); texture coordinates of the spheres and disks.
 
@@ -86,15 +87,30 @@ impl<'a> Builder<'a> {
                 let to_uv = self.to_uv(&mut f)?;
                 Texture::Checkerboard { color0, color1, to_uv }
             }
+            "mesh_attribute" => {
+                let mut f = self.fields(entry, &[params::MESH_ATTRIBUTE])?;
+                let field = f.field("name");
+                let Some(v) = f.take("name") else {
+                    return self.fail(
+                        f.kind_span.clone(),
+                        &field,
+                        "missing field `name` (required for type \"mesh_attribute\")",
+                    );
+                };
+                let span = v.span();
+                let name: String = self.src.read(v, &field)?;
+                params::attribute_name(&name).map_err(|m| self.src.error(span, field, m))?;
+                let scale = self.param(&mut f, &params::MESH_ATTRIBUTE[1])?.mean(&[]).x;
+                // Its values once the meshes are read (`Builder::build`).
+                self.attribute_textures.push((self.textures.len() as u32, name, scale));
+                Texture::Attribute { values: Arc::new(Vec::new()), scale }
+            }
             other => {
                 let kind = entry.kind();
                 return self.fail(
                     kind.span.clone(),
                     &kind.field,
-                    format!(
-                        "unknown texture type \"{other}\" (bitmap, checkerboard; a mesh_attribute needs a mesh \
-                         that carries attributes, which only the Mitsuba front-end reads)"
-                    ),
+                    format!("unknown texture type \"{other}\" (bitmap, checkerboard, mesh_attribute)"),
                 );
             }
         };

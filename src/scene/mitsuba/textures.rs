@@ -105,10 +105,10 @@ impl Builder<'_> {
             }
             "mesh_attribute" => {
                 let (name, loc) = t.string("name")?.ok_or_else(|| t.refuse("a mesh_attribute needs a name"))?;
-                if !(name.starts_with("vertex_") || name.starts_with("face_")) {
-                    return Err(t.fail(&loc, "name", format!("'{name}' must start with vertex_ or face_")));
-                }
-                let scale = t.float_in("scale", 1.0, -1e30, 1e30)? as f32;
+                crate::material::params::attribute_name(&name).map_err(|m| t.fail(&loc, "name", m))?;
+                let spec = crate::material::params::MESH_ATTRIBUTE[1];
+                let scale = t.float("scale")?.map_or(spec.default, |v| v as f32);
+                spec.check(Color::splat(scale)).map_err(|m| t.fail(&t.named_loc("scale"), "scale", m))?;
                 t.finish("name, scale")?;
                 Draft::Attribute { name, scale, values: Vec::new() }
             }
