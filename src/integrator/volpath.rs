@@ -86,11 +86,6 @@ pub(super) fn radiance(pt: &PathIntegrator, media: &Media, ray: Ray, part: Part,
         }
         ctx.counters.rays += 1;
         let med = medium.map(|m| media.get(m));
-        if med.is_some_and(|m| m.scatters()) {
-            // Light seen through a medium that scatters is the reflected
-            // part's (see `emitted_part`).
-            specular_chain = false;
-        }
         // In a homogeneous medium the flight is drawn first, and a surface
         // sought only closer than it (in fog most flights end in it).
         let drawn = med.filter(|m| m.is_homogeneous() && m.scatters());
@@ -212,10 +207,10 @@ pub(super) fn radiance(pt: &PathIntegrator, media: &Media, ray: Ray, part: Part,
 
 /// The emitted part ([`Part::Emitted`]): light reached from the eye along
 /// specular chains (mirrors, glass, index-matched crossings) through vacuum
-/// or media that only absorb, carrying their exact transmittance. Light
-/// seen through a medium that scatters is the reflected part's: its image
-/// there is a glow, which the extra samples the camera pass gives the
-/// emitted part at the rims of lights' images would not sharpen.
+/// or media, carrying their transmittance: the light that reaches the eye
+/// unscattered. Through thin fog a light's image stays sharp (only dimmer),
+/// and its rim is most of the pixels' noise there, as in vacuum; the glow
+/// about it (light scattered in the medium) is the reflected part's.
 pub(super) fn emitted_part(scene: &Scene, media: &Media, mut ray: Ray, ctx: &mut Context) -> Color {
     let limits = scene.paths;
     let within = |vertices: u32| limits.max_depth.is_none_or(|m| vertices <= m);
@@ -223,7 +218,7 @@ pub(super) fn emitted_part(scene: &Scene, media: &Media, mut ray: Ray, ctx: &mut
     let (mut throughput, mut vertices, mut radiance) = (Color::ONE, 0u32, Color::ZERO);
     for _ in 0..MAX_EVENTS {
         let med = medium.map(|m| media.get(m));
-        if !within(vertices + 1) || med.is_some_and(|m| m.scatters()) {
+        if !within(vertices + 1) {
             break;
         }
         ctx.counters.rays += 1;

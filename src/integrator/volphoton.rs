@@ -83,9 +83,10 @@ impl VolPhotonIntegrator<'_> {
         let mut departure: Option<Departure> = None;
         let mut medium = media.camera;
         // Vertices so far (crossings are none); whether all were specular
-        // and no segment crossed a scattering medium (light met is then
-        // the emitted part's); whether light met now is this estimator's
-        // (no shadow ray could have found it).
+        // (light met is then the emitted part's: the throughput carries
+        // only the transmittance of the media crossed, the light that
+        // reached the eye unscattered); whether light met now is this
+        // estimator's (no shadow ray could have found it).
         let (mut vertices, mut specular_chain, mut count_emitted) = (0u32, true, true);
         for _ in 0..MAX_EVENTS {
             ctx.counters.rays += 1;
@@ -95,7 +96,6 @@ impl VolPhotonIntegrator<'_> {
                 let med = media.get(m);
                 let tr = med.track(&ray, t_surface, ctx.rng, &mut thread.steps);
                 if med.scatters() {
-                    specular_chain = false;
                     let inscattered = self.segment(med, m, &ray, t_surface, ctx, thread);
                     radiance += throughput * ctx.checked(inscattered, "medium");
                 }
