@@ -70,9 +70,21 @@ impl Aabb {
     /// test), `None` where the ray misses it.
     #[inline]
     pub fn clip(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
-        let inv = ray.dir.recip();
-        let a = (self.lo - ray.origin) * inv;
-        let b = (self.hi - ray.origin) * inv;
+        self.clip_inv(ray.origin, ray.dir.recip(), t_max)
+    }
+
+    /// Whether a ray from `origin` with reciprocal direction `inv` crosses
+    /// the box within [0, `t_max`] ([`Self::clip`], the division hoisted
+    /// out of a traversal's many boxes).
+    #[inline]
+    pub fn crossed(&self, origin: Vec3, inv: Vec3, t_max: f32) -> bool {
+        self.clip_inv(origin, inv, t_max).is_some()
+    }
+
+    #[inline]
+    fn clip_inv(&self, origin: Vec3, inv: Vec3, t_max: f32) -> Option<(f32, f32)> {
+        let a = (self.lo - origin) * inv;
+        let b = (self.hi - origin) * inv;
         // NaN (0 * inf, a ray in a slab's plane) loses against any number
         // in min / max, so such an axis cuts nothing.
         let near = a.min(b);

@@ -77,8 +77,12 @@ fn radii(photons: &[VolumePhoton], k: usize, r_max: f32, shrink: f32) -> Vec<f32
         .collect()
 }
 
-/// Photons per leaf of the hierarchy.
-const LEAF: usize = 4;
+/// Photons per leaf of the hierarchy. The spheres overlap heavily (a
+/// camera ray through fog crosses hundreds of them), so a ray visits many
+/// nodes per photon it collects, and a node costs more than a photon's
+/// test: 32 per leaf made 13-volume-caustic's camera pass 1.3 times faster
+/// than 4 (100 x 100, 4 spp, --integrator photon, medians of three).
+const LEAF: usize = 32;
 
 #[derive(Clone, Copy, Debug)]
 struct Node {
@@ -187,12 +191,13 @@ impl VolumeMap {
         if self.nodes.is_empty() {
             return;
         }
+        let inv = ray.dir.recip();
         let mut stack = [0u32; 64];
         let mut top = 1;
         while top > 0 {
             top -= 1;
             let node = self.nodes[stack[top] as usize];
-            if node.bounds.clip(ray, t_max).is_none() {
+            if !node.bounds.crossed(ray.origin, inv, t_max) {
                 continue;
             }
             if node.count == 0 {
