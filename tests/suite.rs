@@ -115,7 +115,7 @@ fn suite_11_envmap_glass() {
 }
 
 // 12-fog-shafts is not held to these bounds yet: at these settings its
-// mean reads about +3.8% (notes/suite.md).
+// mean reads +3% to +16% from seed to seed (notes/suite.md).
 
 #[test]
 fn suite_13_volume_caustic() {
