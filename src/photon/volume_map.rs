@@ -6,7 +6,7 @@
 //! radius (the distance to its k-th nearest neighbour, capped), and a ray
 //! collects every photon whose sphere it crosses, with the 2D kernel
 //! 1 / (π r²) about the ray. The spheres are held in a bounding volume
-//! hierarchy (median splits, leaves of a few photons).
+//! hierarchy (median splits, leaves of up to `LEAF` photons).
 
 use crate::math::{Color, Ray};
 use crate::medium::Aabb;
