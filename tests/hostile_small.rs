@@ -205,3 +205,16 @@ fn export_neither_creates_directories_nor_replaces_other_meshes() {
     assert!(stderr(&o).contains("a mesh file is already there, with other contents"), "{}", stderr(&o));
     assert_eq!(std::fs::read(&mesh).unwrap(), before);
 }
+
+/// `export` of a Mitsuba XML scene is refused by what it is (before: read
+/// as TOML, it failed with "key with no value, expected `=`").
+#[test]
+fn export_refuses_a_mitsuba_scene_by_name() {
+    let dir = scratch_dir("hostile-export-xml");
+    let input = dir.join("scene.xml");
+    std::fs::write(&input, "<scene version=\"3.0.0\"/>\n").unwrap();
+    let o = photonmap(&["export", "--mitsuba", s(&input), s(&dir.join("out.xml"))]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("scene.xml: export writes photonmap's TOML scenes"), "{}", stderr(&o));
+    assert!(!dir.join("out.xml").exists());
+}

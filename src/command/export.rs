@@ -33,6 +33,14 @@ pub fn run(args: Request) -> Result<(), Error> {
         if args.eye.is_some() {
             return Err(Error::Invalid("--eye chooses the built-in room's eye; a scene file has its camera".into()));
         }
+        // A Mitsuba scene read as TOML fails on its first tag with a TOML
+        // parser's message; say what the command reads instead.
+        if scene.extension().is_some_and(|e| e.eq_ignore_ascii_case("xml")) {
+            return Err(Error::Invalid(format!(
+                "{}: export writes photonmap's TOML scenes (.toml) as Mitsuba's; this one is Mitsuba's already",
+                scene.display()
+            )));
+        }
         if same_file(scene, &out) {
             return Err(Error::Invalid(format!("{}: that is the scene being exported", out.display())));
         }
