@@ -110,24 +110,47 @@ impl RoughDielectric {
     /// pdf. `u1` chooses, `u` the normal. `None` where the direction leaves
     /// on the wrong side of the macro surface.
     pub fn sample(&self, wo: Vec3, entering: bool, mode: Transport, u1: f32, u: Vec2) -> Option<(Vec3, Color)> {
+        let (m, c, f) = self.facet(wo, entering, u)?;
+        if u1 < f {
+            self.reflected(wo, m, c, 1.0)
+        } else {
+            // f < 1: no total internal reflection here.
+            self.refracted(wo, m, c, self.eta(entering), mode, 1.0)
+        }
+    }
+
+    /// Both of [`Self::sample`]'s branches about one visible microfacet
+    /// normal (`u`), each weighed by its share of the choice (F reflected,
+    /// 1 - F refracted) instead of chosen by it: their sum's mean is one
+    /// sample's, without the noise of the choice. `None` for a branch that
+    /// leaves on the wrong side or has no share.
+    pub fn sample_both(&self, wo: Vec3, entering: bool, mode: Transport, u: Vec2) -> [Option<(Vec3, Color)>; 2] {
+        let Some((m, c, f)) = self.facet(wo, entering, u) else { return [None, None] };
+        let reflected = if f > 0.0 { self.reflected(wo, m, c, f) } else { None };
+        let refracted = if f < 1.0 { self.refracted(wo, m, c, self.eta(entering), mode, 1.0 - f) } else { None };
+        [reflected, refracted]
+    }
+
+    /// A visible microfacet normal m for `wo`, wo . m and Fresnel's
+    /// reflectance there.
+    fn facet(&self, wo: Vec3, entering: bool, u: Vec2) -> Option<(Vec3, f32, f32)> {
         if !(wo.z > 0.0) {
             return None;
         }
-        let eta = self.eta(entering);
         let m = self.microfacet.sample_visible(wo, u);
         let c = wo.dot(m);
-        if !(c > 0.0) {
-            return None;
-        }
-        let f = fresnel_dielectric(c, 1.0, eta);
-        if u1 < f {
-            let wi = 2.0 * c * m - wo;
-            if !(wi.z > 0.0) {
-                return None;
-            }
-            return Some((wi, self.specular_reflectance * self.microfacet.g1(wi, m)));
-        }
-        // Refraction about m (f < 1: no total internal reflection here).
+        (c > 0.0).then(|| (m, c, fresnel_dielectric(c, 1.0, self.eta(entering))))
+    }
+
+    /// `wo` reflected about m (c = wo . m), its weight times `share`.
+    fn reflected(&self, wo: Vec3, m: Vec3, c: f32, share: f32) -> Option<(Vec3, Color)> {
+        let wi = 2.0 * c * m - wo;
+        (wi.z > 0.0).then(|| (wi, self.specular_reflectance * (share * self.microfacet.g1(wi, m))))
+    }
+
+    /// `wo` refracted about m (c = wo . m, below the critical angle), its
+    /// weight times `share`.
+    fn refracted(&self, wo: Vec3, m: Vec3, c: f32, eta: f32, mode: Transport, share: f32) -> Option<(Vec3, Color)> {
         let sin2_t = (1.0 - c * c) / (eta * eta);
         let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
         let wi = (-wo / eta + (c / eta - cos_t) * m).normalize();
@@ -138,7 +161,7 @@ impl RoughDielectric {
             Transport::Radiance => 1.0 / (eta * eta),
             Transport::Importance => 1.0,
         };
-        Some((wi, self.specular_transmittance * (scale * self.microfacet.g1(wi, m))))
+        Some((wi, self.specular_transmittance * (share * scale * self.microfacet.g1(wi, m))))
     }
 }
 
@@ -163,6 +186,45 @@ impl ThinDielectric {
             2.0 * r / (1.0 + r)
         } else {
             1.0
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::microfacet::Distribution;
+
+    /// Both branches about one normal are what the Fresnel choice between
+    /// them gives on average over the choosing number: the same
+    /// directions, and weights that sum to the choice's mean weight.
+    #[test]
+    fn both_branches_are_the_choice_averaged() {
+        for (entering, alpha) in [(true, 0.1), (false, 0.1), (false, 0.4), (true, 0.6)] {
+            let glass = RoughDielectric {
+                microfacet: Microfacet::new(Distribution::Ggx, alpha, alpha),
+                int_ior: 1.5,
+                ext_ior: 1.0,
+                specular_reflectance: Color::new(0.9, 0.8, 0.7),
+                specular_transmittance: Color::new(0.6, 0.7, 0.8),
+            };
+            for k in 0..50 {
+                let t = 0.05 + 1.4 * k as f32 / 50.0;
+                let wo = Vec3::new(t.sin(), 0.0, t.cos());
+                let u = Vec2::new((k as f32 * 0.618_034).fract(), (k as f32 * 0.414_214).fract());
+                let both = glass.sample_both(wo, entering, Transport::Radiance, u);
+                let (mut mean, n) = (Color::ZERO, 2000);
+                for i in 0..n {
+                    let u1 = (i as f32 + 0.5) / n as f32;
+                    if let Some((wi, w)) = glass.sample(wo, entering, Transport::Radiance, u1, u) {
+                        let branch = both[(wi.z < 0.0) as usize].expect("a branch the choice takes");
+                        assert!(branch.0.distance(wi) < 1e-6, "{wi} against {}", branch.0);
+                        mean += w / n as f32;
+                    }
+                }
+                let sum = both.iter().flatten().fold(Color::ZERO, |a, b| a + b.1);
+                assert!((sum - mean).abs().max_element() < 2e-3, "wo {wo}: {sum} against {mean}");
+            }
         }
     }
 }

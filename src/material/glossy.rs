@@ -89,6 +89,29 @@ impl Glossy<'_> {
         }
     }
 
+    /// Rough glass's two branches about one microfacet normal, each
+    /// weighed by its Fresnel share ([`RoughDielectric::sample_both`]),
+    /// where `split` asks for it; otherwise, or for any other lobe, one
+    /// [`Self::sample`] (the same random numbers as without the question).
+    pub fn sample_split(
+        &self,
+        wo: Vec3,
+        entering: bool,
+        mode: Transport,
+        split: bool,
+        rng: &mut Rng,
+    ) -> [Option<(Vec3, Color)>; 2] {
+        match self {
+            Glossy::Dielectric(d) if split => d.sample_both(wo, entering, mode, next_2d(rng)),
+            _ => [self.sample(wo, entering, mode, rng), None],
+        }
+    }
+
+    /// Whether [`Self::sample_split`] splits (rough glass).
+    pub fn splits(&self) -> bool {
+        matches!(self, Glossy::Dielectric(_))
+    }
+
     /// Where a material has both a glossy lobe and specular branches (only
     /// Phong), the chance that a path going on through one of them takes
     /// a branch: their albedos' shares.

@@ -314,6 +314,7 @@ pub fn photon_integrator<'a>(
             caustic_reuse: settings.caustic_reuse,
             defer_reads: true,
             mis: true,
+            rough_splits: crate::integrator::photon::ROUGH_SPLITS,
         },
     }
 }

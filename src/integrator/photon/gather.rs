@@ -75,7 +75,7 @@ impl<'a> PhotonIntegrator<'a> {
                 BsdfSample { compensated: true, ..self.bsdf_sample(hit, n, pdf) }
             });
             let (ray, dep) = hit.spawn(dir);
-            sum += c * self.gather(ray, dep, Lobe::Diffuse, sample, w * rho * c, sh);
+            sum += c * self.gather(ray, dep, Lobe::Diffuse, sample, 0, w * rho * c, sh);
         }
         rho * sum
     }
@@ -120,12 +120,18 @@ impl<'a> PhotonIntegrator<'a> {
     /// stands for a specular one while the path is still a diffuse
     /// vertex's (`from` diffuse): the light it brings is the caustic map's,
     /// so it takes no shadow rays and is passed through like glass.
+    ///
+    /// At its first `splits` rough-glass vertices passed as glossy ones the
+    /// path follows both branches about the sampled microfacet normal
+    /// ([`ROUGH_SPLITS`]): the reflected one by a gather of its own.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn gather(
         &self,
         mut ray: Ray,
         mut dep: Departure,
         mut from: Lobe,
         mut shared: Option<BsdfSample>,
+        mut splits: u32,
         w: Color,
         sh: &mut Shade<'_, '_, 'a>,
     ) -> Color {
@@ -198,26 +204,32 @@ impl<'a> PhotonIntegrator<'a> {
                 specular = true;
                 frame.to_world(b.wi).normalize()
             } else {
-                let Some((wi, gw)) = glossy.and_then(|g| g.sample(wo, entering, Transport::Radiance, sh.ctx.rng))
-                else {
-                    break;
-                };
+                let Some(g) = glossy else { break };
+                let split = splits > 0 && !caustic_glossy && g.splits();
+                let [first, second] = g.sample_split(wo, entering, Transport::Radiance, split, sh.ctx.rng);
+                if split {
+                    // The reflected branch by a gather of its own, the
+                    // refracted one on in this loop.
+                    splits -= 1;
+                    if let Some((wi, gw)) = first {
+                        let dir = frame.to_world(wi).normalize();
+                        if y.shading_normal == y.normal || y.leaves_as(ray.dir, dir, true) {
+                            let pdf = |g: Glossy<'_>| (1.0 - p_specular) * g.pdf(wo, wi, entering);
+                            let sample = mis.map(|g| self.bsdf_sample(&y, frame.n, pdf(g)));
+                            let (next, next_dep) = y.spawn(dir);
+                            let weight = weight * gw / (1.0 - p_specular);
+                            found += weight * self.gather(next, next_dep, Lobe::Glossy, sample, splits, w * weight, sh);
+                        }
+                    }
+                }
+                let Some((wi, gw)) = (if split { second } else { first }) else { break };
                 weight *= gw / (1.0 - p_specular);
                 if caustic_glossy {
                     specular = true;
                 } else {
                     (from, specular) = (Lobe::Glossy, false);
                 }
-                if let Some(g) = mis {
-                    let pdf = (1.0 - p_specular) * g.pdf(wo, wi, entering);
-                    shared = Some(BsdfSample {
-                        point: y.point,
-                        normal: frame.n,
-                        pdf,
-                        shadow_rays: self.settings.shadow_rays,
-                        compensated: false,
-                    });
-                }
+                shared = mis.map(|g| self.bsdf_sample(&y, frame.n, (1.0 - p_specular) * g.pdf(wo, wi, entering)));
                 frame.to_world(wi).normalize()
             };
             if y.shading_normal != y.normal && !y.leaves_as(ray.dir, next_dir, frame.to_local(next_dir).z > 0.0) {

@@ -41,6 +41,13 @@ use gather::gather_density;
 /// first glass vertices (no noise from the choice where it matters most);
 /// deeper, Fresnel picks one branch.
 const SPLIT_DEPTH: u32 = 2;
+/// The same at rough glass: a camera path follows both branches about
+/// each sampled microfacet normal at its first two rough-glass vertices
+/// (a frosted ball's near and far side), one chosen by Fresnel deeper.
+/// The choice at the far side was most of a frosted ball's noise
+/// (notes/suite.md, 09-frosted-glass); a split costs one path more, and
+/// two splits at most quadruple the paths of a glossy camera vertex.
+pub const ROUGH_SPLITS: u32 = 2;
 /// Specular chains are cut after this many bounces (light trapped by total
 /// internal reflection; its share is negligible).
 const MAX_SPECULAR_DEPTH: u32 = 24;
@@ -77,6 +84,13 @@ pub struct PhotonEstimator {
     /// the lobe's own samples ([`super::mis`]; off: shadow rays alone, the
     /// estimate it must agree with in the mean).
     pub mis: bool,
+    /// At how many of a camera path's first rough-glass vertices (from
+    /// its first glossy one on) the path follows both the reflected and
+    /// the refracted branch about the sampled microfacet normal, each
+    /// weighed by its Fresnel share, instead of one chosen by it
+    /// ([`ROUGH_SPLITS`]; 0: never, the estimate it must agree with in
+    /// the mean).
+    pub rough_splits: u32,
 }
 
 /// A read of precomputed irradiance that a camera sample leaves for later:
@@ -337,14 +351,21 @@ impl<'a> PhotonIntegrator<'a> {
             // Gather rays from the glossy lobe: indirect light it reflects,
             // and with MIS the direct light they meet (each weighed as one
             // of `rays` samples).
+            // Rough glass splits here (each branch's MIS weight still by
+            // the lobe's pdf: the shadow rays' weights use the same, so
+            // the two sum to one).
+            let split = s.rough_splits > 0 && g.splits();
+            let splits = s.rough_splits - split as u32;
             for _ in 0..glossy_rays {
-                let Some((wi, weight)) = g.sample(wo, entering, Transport::Radiance, sh.ctx.rng) else { continue };
-                let dir = frame.to_world(wi).normalize();
-                if hit.leaves_as(-frame.n, dir, wi.z > 0.0) {
-                    let (next, dep) = hit.spawn(dir);
-                    let sample = mis.map(|g| self.bsdf_sample(hit, n, rays * g.pdf(wo, wi, entering)));
-                    let weight = weight / rays;
-                    indirect += weight * self.gather(next, dep, Lobe::Glossy, sample, w * weight, sh);
+                let branches = g.sample_split(wo, entering, Transport::Radiance, split, sh.ctx.rng);
+                for (wi, weight) in branches.into_iter().flatten() {
+                    let dir = frame.to_world(wi).normalize();
+                    if hit.leaves_as(-frame.n, dir, wi.z > 0.0) {
+                        let (next, dep) = hit.spawn(dir);
+                        let sample = mis.map(|g| self.bsdf_sample(hit, n, rays * g.pdf(wo, wi, entering)));
+                        let weight = weight / rays;
+                        indirect += weight * self.gather(next, dep, Lobe::Glossy, sample, splits, w * weight, sh);
+                    }
                 }
             }
         }
