@@ -123,8 +123,8 @@ fn mesh_attributes_and_blends_colour_each_face() {
         &dir,
         "q.ply",
         "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
-         element face 2\nproperty list uchar int vertex_indices\nproperty float color_r\nproperty float color_g\n\
-         property float color_b\nproperty float weight\nend_header\n\
+         element face 2\nproperty list uchar int vertex_indices\nproperty float r\nproperty float g\n\
+         property float b\nproperty float weight\nend_header\n\
          -1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n3 0 1 2 0.9 0.1 0.1 0\n3 0 2 3 0.1 0.1 0.9 1\n",
     );
     let text = plane("", "").replace(

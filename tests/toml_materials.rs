@@ -588,8 +588,10 @@ color = [30, 30, 30]
 }
 
 /// A PLY mesh's vertex and face colours as `mesh_attribute` textures:
-/// the TOML scene renders as the same scene written in Mitsuba's XML, to
-/// the bit; a name that is no attribute's is refused at its field.
+/// the TOML scene renders as the same scene written in Mitsuba's XML, and
+/// as its Mitsuba export read back, to the bit; a sphere of such a
+/// material is refused by the export, and a name that is no attribute's
+/// by the reader, each at its place.
 #[test]
 fn mesh_attributes_read_from_ply_as_in_mitsuba() {
     let dir = scratch_dir("toml_materials_attributes");
@@ -659,21 +661,47 @@ color = [10, 10, 10]
     std::fs::write(dir.join("scene.toml"), &toml).unwrap();
     std::fs::write(dir.join("scene.xml"), xml).unwrap();
     let file = photonmap::scene::file::load(&dir.join("scene.toml")).unwrap_or_else(|e| panic!("{e}"));
-    // The export does not write them yet: refused, at the material.
-    let refused = to_mitsuba(&file.parts, Some(&file.origins), "m", Placement::new(glam::Vec3::ZERO, 1.0).unwrap())
-        .err()
-        .expect("refused")
-        .describe(Some(&file.origins));
-    assert!(refused.contains("mesh attribute") && refused.contains("materials.painted"), "{refused}");
+    // The export writes each attribute into every mesh, as vertex
+    // properties (the face colours repeated at their faces' corners).
+    let exported =
+        to_mitsuba(&file.parts, Some(&file.origins), "attr-meshes", Placement::new(glam::Vec3::ZERO, 1.0).unwrap())
+            .unwrap_or_else(|e| panic!("{}", e.describe(Some(&file.origins))));
+    assert_eq!(exported.xml.matches("type=\"mesh_attribute\"").count(), 2, "{}", exported.xml);
+    assert_eq!(exported.meshes.len(), 2);
+    for (_, bytes) in &exported.meshes {
+        let text = String::from_utf8_lossy(bytes);
+        assert_eq!(text.matches("property float attr").count(), 6, "{text}");
+    }
+    std::fs::create_dir_all(dir.join("attr-meshes")).unwrap();
+    for (name, bytes) in &exported.meshes {
+        std::fs::write(dir.join(name), bytes).unwrap();
+    }
+    std::fs::write(dir.join("exported.xml"), &exported.xml).unwrap();
     let a = file.parts;
     let mut b = read_xml(&dir.join("scene.xml"));
     b.camera = a.camera;
-    let (a, b) = (Scene::from_parts(a), Scene::from_parts(b));
-    let (fa, fb) = (render_quiet(&a, &settings(&a)), render_quiet(&b, &settings(&b)));
+    let mut c = read_xml(&dir.join("exported.xml"));
+    c.camera = a.camera;
+    let (a, b, c) = (Scene::from_parts(a), Scene::from_parts(b), Scene::from_parts(c));
+    let (fa, fb, fc) =
+        (render_quiet(&a, &settings(&a)), render_quiet(&b, &settings(&b)), render_quiet(&c, &settings(&c)));
     // Colours vary over the image (the attributes are read, not zero).
     let hues = fa.pixels.iter().filter(|p| p.max_element() > 1e-3 && p.max_element() > 2.0 * p.min_element()).count();
     assert!(hues > 50, "{hues} coloured pixels");
     assert_eq!(differing(&fa, &fb), 0, "pixels differ between the TOML and the XML scene");
+    assert_eq!(differing(&fa, &fc), 0, "pixels differ between the TOML scene and its export read back");
+
+    // A sphere carries no attributes: one whose material reads them is
+    // refused, at the shape (Mitsuba 3.9.1 refuses to render it).
+    let sphere =
+        format!("{toml}\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 3, 0]\nradius = 0.5\nmaterial = \"painted\"\n");
+    std::fs::write(dir.join("sphere.toml"), &sphere).unwrap();
+    let file = photonmap::scene::file::load(&dir.join("sphere.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let refused = to_mitsuba(&file.parts, Some(&file.origins), "m", Placement::new(glam::Vec3::ZERO, 1.0).unwrap())
+        .err()
+        .expect("refused")
+        .describe(Some(&file.origins));
+    assert!(refused.contains("mesh_attribute") && refused.contains("shapes[2]"), "{refused}");
 
     let bad = toml.replace("name = \"vertex_color\"", "name = \"color\"");
     std::fs::write(dir.join("bad.toml"), &bad).unwrap();

@@ -6,7 +6,7 @@
 //! | photonmap | Mitsuba 3 |
 //! |---|---|
 //! | camera (corners or look-at) | `perspective`, off-centre by `principal_point_offset_x/y`; a thin lens as `thinlens`, an orthographic camera as `orthographic` (module `mitsuba_sensor`); a plane that is not a rectangle of square pixels, a mirrored one, or an off-centre thin lens is refused |
-//! | triangles, meshes, tetrahedra, the room | `ply` meshes (vertex normals where the mesh is smooth, `face_normals` otherwise) |
+//! | triangles, meshes, tetrahedra, the room | `ply` meshes (vertex normals where the mesh is smooth, `face_normals` otherwise; every `mesh_attribute` texture's values as vertex properties, read as `vertex_attrN`: `mitsuba_recipe::mesh_attributes`) |
 //! | sphere, disk | `sphere`, `disk` (by transform) |
 //! | ellipsoid | `sphere` when the transform scales evenly (with its `to_world` where it turns or mirrors: the same texture coordinates); else a 20,480-triangle `ply` with exact normals at its vertices (Mitsuba's sphere takes no uneven scale), in a textured scene with the sphere's coordinates at them (interpolated between), and a note says so |
 //! | lambertian, mirror | `twosided` `diffuse`, `twosided` `conductor` (photonmap's are two-sided) |
@@ -142,6 +142,8 @@ pub fn to_mitsuba(
     }
     let mut bsdfs = String::new();
     let mut copied = Vec::new();
+    // Which materials read a mesh attribute (a blend's parts included).
+    let mut reads_attributes = vec![false; parts.materials.len()];
     for (i, m) in parts.materials.iter().enumerate().filter(|(i, _)| used[*i]) {
         let id = format!("material{i}");
         let xml = if super::mitsuba_recipe::needed(parts, i) {
@@ -151,6 +153,7 @@ pub fn to_mitsuba(
             bsdf(m, &id)
         };
         let xml = xml.map_err(|msg| refuse(place(&|o| o.materials.get(i)), msg))?;
+        reads_attributes[i] = xml.contains("type=\"mesh_attribute\"");
         bsdfs += &xml;
         if let Material::Glass { absorption, .. } = m {
             if *absorption != Color::ZERO {
@@ -171,11 +174,21 @@ pub fn to_mitsuba(
         out.media = true;
     }
     let interface = |list: &[Option<crate::medium::Interface>], i: usize| list.get(i).copied().flatten();
+    for _ in 0..parts.materials.len() {
+        for m in 0..parts.materials.len() {
+            if super::mitsuba_recipe::parts_of(parts, m)
+                .is_some_and(|k| k.iter().any(|&k| reads_attributes[k as usize]))
+            {
+                reads_attributes[m] = true;
+            }
+        }
+    }
 
     // Geometry: a mesh per run of triangles of one object, material and
     // shading; analytic shapes one by one.
     let mut shapes = String::new();
     let mut run: Option<(u32, u32, PlyMesh)> = None;
+    let attributes = super::mitsuba_recipe::mesh_attributes(&parts.texturing.textures);
     let mut run_media = None;
     let refs = |m: u32, media| {
         material_refs(parts, m, media).map_err(|msg| refuse(place(&|o| o.materials.get(m as usize)), msg))
@@ -202,12 +215,14 @@ pub fn to_mitsuba(
                     shapes += &out.mesh(mesh, &refs(m, run_media)?, "");
                 }
                 let mesh = if uv.is_some() { PlyMesh::textured(smooth) } else { PlyMesh::new(smooth) };
+                let mesh = mesh.with_attributes(attributes.iter().map(|a| a.0.clone()).collect());
                 run = Some((p.object, p.material, mesh));
                 run_media = media;
             }
             let normals = if smooth { parts.shading_normals[t.shading as usize] } else { [t.normal; 3] };
             if let Some((_, _, mesh)) = run.as_mut() {
-                mesh.push_uv([t.v0, t.v1, t.v2].map(at), normals, uv.unwrap_or_default());
+                let value = |a: usize, k: usize| attributes[a].1.get(i).map_or(Color::ZERO, |v| v[k]);
+                mesh.push_corners([t.v0, t.v1, t.v2].map(at), normals, uv.unwrap_or_default(), value);
             }
             continue;
         }
@@ -215,6 +230,15 @@ pub fn to_mitsuba(
             shapes += &out.mesh(mesh, &refs(m, run_media)?, "");
         }
         let refs = |m: u32| refs(m, media);
+        // Only the meshes carry the attributes; Mitsuba 3.9.1 refuses to
+        // render a shape that lacks one its material reads (photonmap
+        // reads 0 there).
+        if reads_attributes[p.material as usize] {
+            return Err(refuse(
+                place(&|o| o.objects.get(p.object as usize)),
+                format!("a {} whose material reads a mesh_attribute texture has no equivalent in Mitsuba 3 (only meshes carry attributes)", p.shape.name()),
+            ));
+        }
         shapes += &match &p.shape {
             Shape::Sphere(sphere) => format!(
                 "    <shape type=\"sphere\">\n        <point name=\"center\" value=\"{}\"/>\n        <float name=\"radius\" value=\"{}\"/>\n{}    </shape>\n",

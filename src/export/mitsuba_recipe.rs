@@ -7,6 +7,7 @@
 //! Sidedness is written as the Mitsuba front-end reads it back: an opaque
 //! two-sided material inside `twosided`, dielectrics and blends bare.
 
+use super::ply::VertexAttribute;
 use crate::material::params::{self, Spec};
 use crate::material::{Material, Param, PrincipledRecipe, Textured, ThinRecipe};
 use crate::math::Color;
@@ -300,11 +301,36 @@ impl Writer<'_, '_, '_> {
                 to_uv_xml(to_uv)
             ),
             Texture::Constant(c) => format!("<texture type=\"rawconstant\"{name}>{}</texture>", rgb("value", *c)),
-            Texture::Attribute { .. } => {
-                return Err("a mesh attribute texture has no form in the Mitsuba export yet".into());
-            }
+            // Every exported mesh carries the attribute (`mesh_attributes`).
+            Texture::Attribute { scale, .. } => format!(
+                "<texture type=\"mesh_attribute\"{name}><string name=\"name\" value=\"vertex_{}\"/>{}</texture>",
+                attribute_name(t),
+                float("scale", *scale)
+            ),
         })
     }
+}
+
+/// The name of the PLY properties that carry attribute texture `t`.
+fn attribute_name(t: u32) -> String {
+    format!("attr{t}")
+}
+
+/// The scene's mesh attributes (`mesh_attribute` textures), as the
+/// exported meshes carry them: each with its values per primitive (at its
+/// three corners). A primitive without the attribute reads zero in
+/// photonmap and in Mitsuba alike, so every mesh carries every attribute.
+pub(super) fn mesh_attributes(textures: &[Texture]) -> Vec<(VertexAttribute, &[[Color; 3]])> {
+    let grey = |c: &Color| c.x == c.y && c.y == c.z;
+    (0..textures.len() as u32)
+        .filter_map(|t| match &textures[t as usize] {
+            Texture::Attribute { values, .. } => Some((
+                VertexAttribute { name: attribute_name(t), grey: values.iter().flatten().all(grey) },
+                &values[..],
+            )),
+            _ => None,
+        })
+        .collect()
 }
 
 /// A texture's `to_uv` as a 4x4 matrix (none for the identity).

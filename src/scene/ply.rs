@@ -22,7 +22,9 @@ pub struct PlyMesh {
     /// The other properties of vertices and faces, grouped as Mitsuba 3
     /// groups them (ply.cpp): `{prefix}_{x|y|z|w}`, `_{r|g|b|a}`,
     /// `_{0|1|2|3}` or `_{1|2|3|4}` in a row make one attribute
-    /// `vertex_{prefix}` or `face_{prefix}`; `r g b (a)` or `red green blue
+    /// `vertex_{prefix}` or `face_{prefix}` (`vertex_{prefix}_color` for
+    /// `_{r|g|b|a}`, as ply.h's `find_other_fields` names it, though its
+    /// documentation says otherwise); `r g b (a)` or `red green blue
     /// (alpha)` make `*_color`; any other property is one of its own.
     pub attributes: Vec<Attribute>,
 }
@@ -83,7 +85,9 @@ fn group_attributes(candidates: &[(usize, String)]) -> Vec<(String, Vec<usize>)>
                 for sch in SCHEMES {
                     let n = run(prefix, &sch, true);
                     if n >= 1 && name.ends_with(&format!("_{}", sch[0])) {
-                        taken = Some((prefix.to_string(), n));
+                        // ply.h names an `_r _g _b` group `{prefix}_color`.
+                        let colour = if sch[0] == "r" { "_color" } else { "" };
+                        taken = Some((format!("{prefix}{colour}"), n));
                         break;
                     }
                 }
@@ -540,14 +544,20 @@ mod tests {
         let text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
                     property float r\nproperty float g\nproperty float b\nproperty float temp\n\
                     element face 2\nproperty list uchar int vertex_indices\nproperty float w_0\nproperty float w_1\n\
-                    property float q_x\nend_header\n\
-                    0 0 0 1 0 0 5\n1 0 0 0 1 0 6\n1 1 0 0 0 1 7\n0 1 0 1 1 1 8\n4 0 1 2 3 0.25 0.5 9\n3 0 1 2 1 2 3\n";
+                    property float q_x\nproperty float k_r\nproperty float k_g\nproperty float k_b\nend_header\n\
+                    0 0 0 1 0 0 5\n1 0 0 0 1 0 6\n1 1 0 0 0 1 7\n0 1 0 1 1 1 8\n4 0 1 2 3 0.25 0.5 9 1 2 3\n3 0 1 2 1 2 3 4 5 6\n";
         let m = parse(text.as_bytes()).unwrap();
         let names: Vec<(&str, bool, usize)> =
             m.attributes.iter().map(|a| (a.name.as_str(), a.per_face, a.dim)).collect();
         assert_eq!(
             names,
-            [("vertex_color", false, 3), ("vertex_temp", false, 1), ("face_w", true, 2), ("face_q", true, 1)]
+            [
+                ("vertex_color", false, 3),
+                ("vertex_temp", false, 1),
+                ("face_w", true, 2),
+                ("face_q", true, 1),
+                ("face_k_color", true, 3)
+            ]
         );
         assert_eq!(m.attributes[0].color(1), Vec3::Y);
         assert_eq!(m.attributes[1].color(3), Vec3::splat(8.0));
