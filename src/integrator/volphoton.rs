@@ -16,9 +16,10 @@
 //! |                               | read directly at the diffuse vertex         |
 //! | L S+ G (S\|G)* E              | emission met after the specular chain       |
 //!
-//! Transmittance is exact in homogeneous media and estimated by ratio
-//! tracking in heterogeneous ones; surfaces behind a medium are seen
-//! through it. The maps are read directly (no final gathering), so their
+//! Transmittance along camera segments is exact in both kinds of media
+//! (a heterogeneous one's integrated along its grid's cells); shadow rays
+//! estimate it by ratio tracking in heterogeneous ones. Surfaces behind a
+//! medium are seen through it. The maps are read directly (no final gathering), so their
 //! radii shrink from pass to pass as progressive photon mapping's do.
 
 use super::volpath::{emitted_part, roulette, sample_li_everywhere, surface_light, transmittance};
@@ -94,7 +95,7 @@ impl VolPhotonIntegrator<'_> {
             let t_surface = hit.as_ref().map_or(f32::INFINITY, |h| h.t);
             if let Some(m) = medium {
                 let med = media.get(m);
-                let tr = med.track(&ray, t_surface, ctx.rng, &mut thread.steps);
+                let tr = med.track(&ray, t_surface, &mut thread.steps);
                 if med.scatters() {
                     let inscattered = self.segment(med, m, &ray, t_surface, ctx, thread);
                     radiance += throughput * ctx.checked(inscattered, "medium");

@@ -195,6 +195,77 @@ impl Grid {
     }
 }
 
+impl Grid {
+    /// The integral of the grid's value along `ray` over [`t0`, `t1`],
+    /// exact to rounding: `piece` is told the distance at the end of each
+    /// piece and the integral up to it. The walk visits every piece
+    /// between the planes where the lookup changes formula (cell centres
+    /// for trilinear lookups, cell faces for the nearest), as Amanatides
+    /// and Woo's voxel traversal does (1987); within a piece a trilinear
+    /// lookup along a line is a cubic in t (a constant for the nearest
+    /// cell), which two-point Gauss–Legendre integrates exactly. A piece
+    /// whose integral exceeds `fine` in some channel is cut into equal
+    /// parts below it, so that a reader interpolating between the
+    /// pieces' ends errs little.
+    pub fn integrate(&self, ray: &Ray, t0: f32, t1: f32, fine: f32, mut piece: impl FnMut(f32, Color)) -> Color {
+        let res = Vec3::from_array(self.data.res.map(|r| r as f32));
+        let shift = match self.filter {
+            Filter::Trilinear => 0.5,
+            Filter::Nearest => 0.0,
+        };
+        // Grid coordinates along the ray: g(t) = g0 + dg t, the lookup's
+        // formula changing where a coordinate crosses an integer.
+        let g0 = self.to_local.transform_point3(ray.origin) * res - Vec3::splat(shift);
+        let dg = self.to_local.transform_vector3(ray.dir) * res;
+        let mut next = Vec3::splat(f32::INFINITY);
+        let mut step = Vec3::splat(f32::INFINITY);
+        for a in 0..3 {
+            if dg[a] != 0.0 {
+                let g = g0[a] + dg[a] * t0;
+                let boundary = if dg[a] > 0.0 { g.floor() + 1.0 } else { g.ceil() - 1.0 };
+                next[a] = (boundary - g0[a]) / dg[a];
+                step[a] = 1.0 / dg[a].abs();
+            }
+        }
+        // Two-point Gauss–Legendre: nodes at ±1/√3 of the half-width.
+        let node = 0.5 / 3f32.sqrt();
+        let gauss = |a: f32, b: f32| {
+            (self.eval(ray.at(0.5 * (a + b) - node * (b - a))) + self.eval(ray.at(0.5 * (a + b) + node * (b - a))))
+                * (0.5 * (b - a))
+        };
+        // At most one piece per plane crossed, and the last.
+        let bound = ((dg.abs() * (t1 - t0)).element_sum() + 4.0).min(1e7) as usize;
+        let mut sum = Color::ZERO;
+        let mut t = t0;
+        for _ in 0..bound {
+            let end = next.min_element().min(t1).max(t);
+            let whole = gauss(t, end);
+            let parts = (whole.max_element() / fine).ceil();
+            if parts > 1.0 && parts.is_finite() {
+                let (n, h) = (parts as usize, (end - t) / parts);
+                for i in 0..n {
+                    let (a, b) = (t + i as f32 * h, if i + 1 == n { end } else { t + (i + 1) as f32 * h });
+                    sum += gauss(a, b);
+                    piece(b, sum);
+                }
+            } else {
+                sum += whole;
+                piece(end, sum);
+            }
+            if !(end < t1) {
+                break;
+            }
+            t = end;
+            for a in 0..3 {
+                if next[a] <= end {
+                    next[a] += step[a];
+                }
+            }
+        }
+        sum
+    }
+}
+
 /// Cell index `i` of `n` read by wrap mode `mode`. Coordinates far outside
 /// the grid arrive as saturated integers and stay in range.
 #[inline]
@@ -220,6 +291,22 @@ impl Volume {
         match self {
             Volume::Constant { value, .. } => *value,
             Volume::Grid(g) => g.eval(p),
+        }
+    }
+
+    /// The integral of the value along `ray` over [`t0`, `t1`], exact to
+    /// rounding, told piece by piece as [`Grid::integrate`] tells it.
+    pub fn integrate(&self, ray: &Ray, t0: f32, t1: f32, fine: f32, mut piece: impl FnMut(f32, Color)) -> Color {
+        match self {
+            Volume::Constant { value, .. } => {
+                let parts = (value.max_element() * (t1 - t0) / fine).ceil().clamp(1.0, 1e6) as usize;
+                let h = (t1 - t0) / parts as f32;
+                for i in 1..=parts {
+                    piece(if i == parts { t1 } else { t0 + i as f32 * h }, *value * (i as f32 * h));
+                }
+                *value * (t1 - t0)
+            }
+            Volume::Grid(g) => g.integrate(ray, t0, t1, fine, piece),
         }
     }
 
