@@ -99,6 +99,30 @@ mod tests {
         assert!(all.camera.rays >= none.camera.rays + 48 * 48, "{} {}", all.camera.rays, none.camera.rays);
     }
 
+    /// In a room lined with mirrors the light's images fill most of the
+    /// view and each probe of the emitted part follows the mirrors to the
+    /// depth limit, costing more than a whole sample: no pixel is taken for
+    /// a rim there (before, most were, at twice a pass's cost). The plain
+    /// room keeps its rim.
+    #[test]
+    fn a_mirror_lined_room_has_no_rims() {
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/tncg15.toml")).unwrap();
+        let walls = "floor = \"grey\"\nceiling = \"grey\"\nwalls = [\"magenta\", \"red\", \"yellow\", \"blue\", \"green\", \"cyan\"]";
+        assert!(text.contains(walls));
+        let mirrors = format!("floor = \"mirror\"\nceiling = \"mirror\"\nwalls = [{}]", ["\"mirror\""; 6].join(", "));
+        let settings =
+            Settings { photons: 5_000, caustic_photons: 5_000, width: 64, height: 64, spp: 4, ..Settings::default() };
+        let unit = settings.method.unit(&settings);
+        let rims = |text: &str| {
+            let file = crate::scene::file::parse(text, std::path::Path::new("room.toml")).unwrap();
+            let scene = Scene::from_parts(file.parts);
+            render_pass(&scene, &settings, unit.as_ref(), 0, Mode::Quiet, &mut None).1.edge_pixels
+        };
+        let (plain, mirrored) = (rims(&text), rims(&text.replace(walls, &mirrors)));
+        assert!(plain > 0, "{plain}");
+        assert_eq!(mirrored, 0);
+    }
+
     /// Cache reads left for the end of a pixel and resolved together give
     /// what reads made at once give, to rounding: the weights they carry
     /// follow the camera path through glass (both branches at the first

@@ -18,8 +18,10 @@ const PROBES: u32 = 4;
 /// Which pixels see part of a light's surface and part of something else
 /// (directly or through mirrors and glass): those whose probes disagree, or
 /// whose neighbours' probes disagree with theirs (a rim thinner than the probe
-/// spacing). The probes use their own random streams, so choosing the pixels
-/// does not bias the samples that later estimate them.
+/// spacing). None where the emitted part is no cheap part of a pixel's
+/// estimate ([`emitted_part_is_cheap`]). The probes use their own random
+/// streams, so choosing the pixels does not bias the samples that later
+/// estimate them.
 pub(super) fn light_rims<I: Integrator>(
     camera: &Camera,
     integrator: &I,
@@ -27,7 +29,9 @@ pub(super) fn light_rims<I: Integrator>(
     counters: &mut Counters,
 ) -> Vec<bool> {
     let (w, h) = (camera.width, camera.height);
-    let lens = camera.projection.has_lens();
+    if !emitted_part_is_cheap(camera, integrator, seed, counters) {
+        return vec![false; w as usize * h as usize];
+    }
     // Rows write into their stretch of one buffer: nothing is joined
     // serially afterwards (at 16 threads the serial stretches of this and
     // the camera pass were 3% of the pass).
@@ -39,21 +43,7 @@ pub(super) fn light_rims<I: Integrator>(
             let row = row as u32;
             let mut row_counters = Counters::default();
             for (col, count) in (0..w).zip(out) {
-                let pixel = row as u64 * w as u64 + col as u64;
-                let mut rng = stream(seed, Domain::EdgeProbes, sample_index(0, pixel));
-                let mut state = I::Pixel::default();
-                let mut ctx = Context { rng: &mut rng, counters: &mut row_counters, pixel };
-                *count = (0..PROBES)
-                    .filter(|&s| {
-                        let u = stratified_2d(s, PROBES, next_2d(ctx.rng));
-                        // Through the lens, a light's image blurs: its rim is
-                        // where some of the lens sees it.
-                        let on_lens = if lens { next_2d(ctx.rng) } else { Vec2::ZERO };
-                        let ray = camera.sample_ray(col, row, u, on_lens);
-                        let seen = integrator.radiance(ray, Part::Emitted, &mut ctx, thread, &mut state);
-                        max_component(seen + integrator.finish(&mut ctx, thread, &mut state)) > 0.0
-                    })
-                    .count() as u8;
+                *count = probe_pixel(camera, integrator, seed, (col, row), thread, &mut row_counters);
             }
             row_counters
         })
@@ -75,4 +65,87 @@ pub(super) fn light_rims<I: Integrator>(
         }
     });
     rims
+}
+
+/// How many of a pixel's probes see emitted light (directly or through
+/// mirrors and glass), from the pixel's own random stream.
+fn probe_pixel<I: Integrator>(
+    camera: &Camera,
+    integrator: &I,
+    seed: u64,
+    (col, row): (u32, u32),
+    thread: &mut I::Thread,
+    counters: &mut Counters,
+) -> u8 {
+    let lens = camera.projection.has_lens();
+    let pixel = row as u64 * camera.width as u64 + col as u64;
+    let mut rng = stream(seed, Domain::EdgeProbes, sample_index(0, pixel));
+    let mut state = I::Pixel::default();
+    let mut ctx = Context { rng: &mut rng, counters, pixel };
+    (0..PROBES)
+        .filter(|&s| {
+            let u = stratified_2d(s, PROBES, next_2d(ctx.rng));
+            // Through the lens, a light's image blurs: its rim is where
+            // some of the lens sees it.
+            let on_lens = if lens { next_2d(ctx.rng) } else { Vec2::ZERO };
+            let ray = camera.sample_ray(col, row, u, on_lens);
+            let seen = integrator.radiance(ray, Part::Emitted, &mut ctx, thread, &mut state);
+            max_component(seen + integrator.finish(&mut ctx, thread, &mut state)) > 0.0
+        })
+        .count() as u8
+}
+
+/// Whether the emitted part is the cheap part of a pixel's estimate, as
+/// the split at the rims presumes: whether a pixel's `PROBES` probes cost
+/// no more rays than one whole camera sample (a light seen directly or
+/// through a few specular vertices, while a whole sample also gathers at
+/// the diffuse surface it meets). Told from the probes of every
+/// `SPARSE`-th pixel of every `SPARSE`-th row and a whole sample at every
+/// other of those (1.5% of the default view's pass of 4 spp). Where the
+/// emitted part costs more, each probe and each extra sample of it costs a
+/// good part of a whole sample, and the probes alone more than another
+/// sample of every pixel: in the TNCG15 room lined with mirrors (200 x 200,
+/// 1e5 photons) a probe followed the mirrors for 24 rays against 45 for a
+/// whole sample, the probes took 40% of a pass of 4 spp, and at equal
+/// camera-pass time the image with rims had the higher RMSE
+/// (notes/performance.md). The default view's probes cost 0.14 of a whole
+/// sample, the suite's 0.12 to 0.19.
+fn emitted_part_is_cheap<I: Integrator>(camera: &Camera, integrator: &I, seed: u64, counters: &mut Counters) -> bool {
+    const SPARSE: u32 = 4;
+    let lens = camera.projection.has_lens();
+    let rows: Vec<u32> = (SPARSE / 2..camera.height).step_by(SPARSE as usize).collect();
+    // Per row: the probes' rays and pixels, the whole samples' rays and count.
+    let per_row: Vec<(Counters, [u64; 4])> = rows
+        .par_iter()
+        .map_init(I::Thread::default, |thread, &row| {
+            let mut row_counters = Counters::default();
+            let mut tally = [0; 4];
+            for col in (SPARSE / 2..camera.width).step_by(SPARSE as usize) {
+                let rays = row_counters.rays;
+                probe_pixel(camera, integrator, seed, (col, row), thread, &mut row_counters);
+                tally[0] += row_counters.rays - rays;
+                tally[1] += 1;
+                if (row / SPARSE + col / SPARSE).is_multiple_of(2) {
+                    let pixel = row as u64 * camera.width as u64 + col as u64;
+                    let mut rng = stream(seed, Domain::EdgeProbes, sample_index(1, pixel));
+                    let mut state = I::Pixel::default();
+                    let rays = row_counters.rays;
+                    let mut ctx = Context { rng: &mut rng, counters: &mut row_counters, pixel };
+                    let u = next_2d(ctx.rng);
+                    let on_lens = if lens { next_2d(ctx.rng) } else { Vec2::ZERO };
+                    let ray = camera.sample_ray(col, row, u, on_lens);
+                    integrator.radiance(ray, Part::All, &mut ctx, thread, &mut state);
+                    integrator.finish(&mut ctx, thread, &mut state);
+                    tally[2] += row_counters.rays - rays;
+                    tally[3] += 1;
+                }
+            }
+            (row_counters, tally)
+        })
+        .collect();
+    let tally = per_row.iter().fold([0; 4], |a, (_, t)| [a[0] + t[0], a[1] + t[1], a[2] + t[2], a[3] + t[3]]);
+    *counters = per_row.into_iter().fold(*counters, |a, (c, _)| a.merge(c));
+    // Probes' rays per pixel against a whole sample's: integers, so any
+    // thread count decides alike.
+    tally[1] == 0 || tally[3] == 0 || tally[0] * tally[3] <= tally[2] * tally[1]
 }
