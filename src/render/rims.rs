@@ -101,7 +101,7 @@ fn probe_pixel<I: Integrator>(
 /// through a few specular vertices, while a whole sample also gathers at
 /// the diffuse surface it meets). Told from the probes of every
 /// `SPARSE`-th pixel of every `SPARSE`-th row and a whole sample at every
-/// other of those (1.5% of the default view's pass of 4 spp). Where the
+/// other of those (0.3% of the rays of the default view's pass). Where the
 /// emitted part costs more, each probe and each extra sample of it costs a
 /// good part of a whole sample, and the probes alone more than another
 /// sample of every pixel: in the TNCG15 room lined with mirrors (200 x 200,
@@ -111,7 +111,7 @@ fn probe_pixel<I: Integrator>(
 /// (notes/performance.md). The default view's probes cost 0.14 of a whole
 /// sample, the suite's 0.12 to 0.19.
 fn emitted_part_is_cheap<I: Integrator>(camera: &Camera, integrator: &I, seed: u64, counters: &mut Counters) -> bool {
-    const SPARSE: u32 = 4;
+    const SPARSE: u32 = 8;
     let lens = camera.projection.has_lens();
     let rows: Vec<u32> = (SPARSE / 2..camera.height).step_by(SPARSE as usize).collect();
     // Per row: the probes' rays and pixels, the whole samples' rays and count.
