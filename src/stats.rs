@@ -22,6 +22,10 @@ pub struct Counters {
     /// another level than its surface, and those that found it hidden.
     pub cache_rays: u64,
     pub cache_hidden: u64,
+    /// Runs whose rim pixels were not sought because a probe of the
+    /// emitted part cost more rays than a whole sample (render::rims), so
+    /// that the summary can say why there are none.
+    pub rims_too_costly: u64,
     /// First non-finite sample seen: (pixel index, estimator name).
     first_nonfinite: Option<(u64, &'static str)>,
 }
@@ -35,6 +39,7 @@ impl Counters {
         self.caustic_reused += other.caustic_reused;
         self.cache_rays += other.cache_rays;
         self.cache_hidden += other.cache_hidden;
+        self.rims_too_costly += other.rims_too_costly;
         if let Some((pixel, estimator)) = other.first_nonfinite {
             self.note_nonfinite(pixel, estimator);
         }

@@ -54,6 +54,12 @@ impl Summary<'_> {
             ));
         }
         let c = &s.camera;
+        if c.rims_too_costly > 0 {
+            out.push(
+                "               no light rims sought: a probe of the emitted part costs more rays than a whole sample here"
+                    .to_string(),
+            );
+        }
         if c.caustic_estimates + c.caustic_reused > 0 {
             out.push(format!(
                 "               {} caustic estimates, {} reused within a pixel ({:.0}%)",

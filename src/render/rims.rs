@@ -30,6 +30,7 @@ pub(super) fn light_rims<I: Integrator>(
 ) -> Vec<bool> {
     let (w, h) = (camera.width, camera.height);
     if !emitted_part_is_cheap(camera, integrator, seed, counters) {
+        counters.rims_too_costly += 1;
         return vec![false; w as usize * h as usize];
     }
     // Rows write into their stretch of one buffer: nothing is joined
