@@ -139,7 +139,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .args(["--width", &w, "--height", &h])
                     .output()?;
                 if !o.status.success() {
-                    return Err(format!("Mitsuba on {}: {}", s.name, String::from_utf8_lossy(&o.stderr)).into());
+                    let err = String::from_utf8_lossy(&o.stderr);
+                    // Dr.Jit's llvm backend finds the system's libLLVM, which
+                    // may be older than the 16 it needs; it then stops here,
+                    // and its error is a page of LLVM's selection DAG.
+                    let said = if err.contains("LLVM ERROR") {
+                        format!(
+                            "{} (Mitsuba's llvm variant needs libLLVM 16 or newer: point DRJIT_LIBLLVM_PATH \
+                             at its .so, as tools/mitsuba_reference.py explains)",
+                            err.lines().next().unwrap_or_default()
+                        )
+                    } else {
+                        err.into_owned()
+                    };
+                    return Err(format!("Mitsuba on {}: {said}", s.name).into());
                 }
                 let v: serde_json::Value = serde_json::from_slice(&o.stdout)?;
                 let scored =
