@@ -15,7 +15,9 @@
 use photonmap::film::accumulation::Accumulation;
 use photonmap::render::{render_passes, Budget};
 use photonmap::scene::Scene;
-use photonmap::settings::{Settings, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP};
+use photonmap::settings::{
+    Settings, PROGRESSIVE_CAUSTIC_PHOTONS, PROGRESSIVE_K_CAUSTIC, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP,
+};
 use plotters::prelude::*;
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -55,7 +57,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let scene = Scene::from_parts(file.parts);
         let settings = Settings {
             photons: PROGRESSIVE_PHOTONS,
-            caustic_photons: PROGRESSIVE_PHOTONS,
+            caustic_photons: PROGRESSIVE_CAUSTIC_PHOTONS,
+            k_caustic: PROGRESSIVE_K_CAUSTIC,
             spp: PROGRESSIVE_SPP,
             width: reference.width,
             height: reference.height,

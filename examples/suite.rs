@@ -22,7 +22,9 @@ use photonmap::output::{read_exr, write, write_rgb8_image};
 use photonmap::progress::Mode;
 use photonmap::render::{render, render_progressive, Budget};
 use photonmap::scene::Scene;
-use photonmap::settings::{Settings, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP};
+use photonmap::settings::{
+    Settings, PROGRESSIVE_CAUSTIC_PHOTONS, PROGRESSIVE_K_CAUSTIC, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP,
+};
 use photonmap::suite::SuiteScene;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -93,7 +95,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let t = Instant::now();
             let p = Settings {
                 photons: PROGRESSIVE_PHOTONS,
-                caustic_photons: PROGRESSIVE_PHOTONS,
+                caustic_photons: PROGRESSIVE_CAUSTIC_PHOTONS,
+                k_caustic: PROGRESSIVE_K_CAUSTIC,
                 spp: PROGRESSIVE_SPP,
                 ..settings
             };
@@ -250,10 +253,10 @@ fn report(rows: &[Row], suite: &[SuiteScene], seconds: f64) -> String {
          tests/data/suite/), with the metric of `photonmap compare`: RMSE over the whole image and the caustic \
          window (scenes/suite/suite.toml), each less the reference's own noise in quadrature; bias is the mean's \
          relative difference. *Default*: photonmap's default settings, timed from loading the scene to the \
-         finished image. *Progressive*: {seconds:.0} s of progressive passes ({} photons and {} spp a pass). \
+         finished image. *Progressive*: {seconds:.0} s of progressive passes ({} global and {} caustic photons, caustic k {}, and {} spp a pass). \
          *Mitsuba*: its path tracer at the same wall time, loading included; *ratio*: Mitsuba's error over \
          photonmap's.\n",
-        PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP
+        PROGRESSIVE_PHOTONS, PROGRESSIVE_CAUSTIC_PHOTONS, PROGRESSIVE_K_CAUSTIC, PROGRESSIVE_SPP
     );
     let _ = writeln!(s, "| scene | ref spp | ref noise (whole / caustic) | default: time | bias | caustic bias | RMSE | caustic RMSE | speckles | Mitsuba RMSE / caustic (spp) | ratio | caustic ratio |");
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");

@@ -229,3 +229,28 @@ fn export_takes_a_negative_origin() {
     // The eye (0, -3.4, 1) less (-0.4, 0.05, 0.35), times 100.
     assert!(text.contains("lookat origin=\"40, -345, 65\""), "{text}");
 }
+
+/// A progressive render given no photon counts takes four times the
+/// caustic photons at four times the caustic k (the estimates' disks of
+/// 250,000 photons at k = 100); given a count, or a k, it keeps what it
+/// was given (the caustic count following the global one).
+#[test]
+fn progressive_passes_take_more_caustic_photons_where_given_no_counts() {
+    let dir = scratch_dir("cli-progressive-counts");
+    let cases: &[(&[&str], &str, &str)] = &[
+        (&[], "250000 global, 1000000 caustic", "k_caustic: 400,"),
+        (&["--photons", "2e4"], "20000 global, 20000 caustic", "k_caustic: 100,"),
+        (&["--caustic-photons", "3e4"], "250000 global, 30000 caustic", "k_caustic: 100,"),
+        (&["--k-caustic", "50"], "250000 global, 1000000 caustic", "k_caustic: 50,"),
+    ];
+    for (i, (given, photons, k)) in cases.iter().enumerate() {
+        let exr = dir.join(format!("p{i}.exr"));
+        let args = ["--passes", "1", "--width", "8", "--height", "8", "--quiet", exr.to_str().unwrap()];
+        let o = photonmap(&[&args[..], given].concat());
+        assert!(o.status.success(), "{given:?}: {}", stderr(&o));
+        let header = photonmap::output::read_header(&exr).unwrap();
+        let get = |key: &str| header.attributes.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone());
+        assert_eq!(get("photons_per_pass").as_deref(), Some(*photons), "{given:?}");
+        assert!(get("settings").unwrap().contains(k), "{given:?}: {:?}", get("settings"));
+    }
+}

@@ -16,7 +16,9 @@ use crate::output::partial::{read_partial, Manifest, Part, Partial};
 use crate::output::read_exr;
 use crate::progress::Mode;
 use crate::provenance::{settings_key, Provenance};
-use crate::render::settings::{Settings, DEFAULT, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP};
+use crate::render::settings::{
+    Settings, DEFAULT, PROGRESSIVE_CAUSTIC_PHOTONS, PROGRESSIVE_K_CAUSTIC, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP,
+};
 use crate::render::{drive, Budget, Method, Observer, Plan, Stopped};
 use crate::scene::Eye;
 use crate::stats::counted;
@@ -48,6 +50,8 @@ pub struct Request {
     /// files.
     pub photons: Option<u64>,
     pub caustic_photons: Option<u64>,
+    /// None: the default, which differs for progressive renders.
+    pub k_caustic: Option<usize>,
     pub spp: Option<u32>,
     pub width: Option<u32>,
     pub height: Option<u32>,
@@ -136,8 +140,18 @@ pub fn run(req: Request) -> Result<Outcome, Error> {
         true => (req.photons.unwrap_or(PROGRESSIVE_PHOTONS), req.spp.unwrap_or(PROGRESSIVE_SPP)),
         false => (req.photons.unwrap_or(DEFAULT.photons), req.spp.unwrap_or(file_spp)),
     };
-    let caustic_photons = req.caustic_photons.unwrap_or(photons);
-    let settings = Settings { method, photons, caustic_photons, spp, width, height, ..req.settings };
+    // A progressive pass given no photon counts takes more caustic photons
+    // at a k that keeps the estimates' disks (PROGRESSIVE_CAUSTIC_PHOTONS).
+    let progressive_caustics = progressive && req.photons.is_none() && req.caustic_photons.is_none();
+    let caustic_photons = match progressive_caustics {
+        true => PROGRESSIVE_CAUSTIC_PHOTONS,
+        false => req.caustic_photons.unwrap_or(photons),
+    };
+    let k_caustic = req.k_caustic.unwrap_or(match progressive_caustics {
+        true => PROGRESSIVE_K_CAUSTIC,
+        false => DEFAULT.k_caustic,
+    });
+    let settings = Settings { method, photons, caustic_photons, k_caustic, spp, width, height, ..req.settings };
     if let Some(reference) = &reference {
         reference_fits(reference, width, height)?;
     }

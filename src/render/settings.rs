@@ -90,6 +90,18 @@ impl Default for Settings {
 pub const PROGRESSIVE_PHOTONS: u64 = 250_000;
 pub const PROGRESSIVE_SPP: u32 = 1;
 
+/// Caustic photons of one progressive pass and the caustic estimate's k,
+/// where the user gives neither (nor `--photons`): four times the global
+/// photons and four times the k, so an estimate's disk is the one that
+/// 250,000 photons at k = 100 gave (the same bias) holding four times the
+/// photons (a quarter of the variance). The camera pass takes most of a
+/// pass and caustic photons stop at their first diffuse hit, so they are
+/// the cheap part: suite scene 09-frosted-glass, 16 passes, caustic
+/// window noise 0.037 -> 0.0185 for 1.38x the time a pass
+/// (notes/suite.md).
+pub const PROGRESSIVE_CAUSTIC_PHOTONS: u64 = 1_000_000;
+pub const PROGRESSIVE_K_CAUSTIC: usize = 400;
+
 /// The default [`Settings::caustic_reuse`].
 pub const CAUSTIC_REUSE: f32 = 0.1;
 

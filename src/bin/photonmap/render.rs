@@ -106,7 +106,8 @@ pub struct RenderArgs {
     /// all work) [default: 1e6; 2.5e5 for progressive renders].
     #[arg(long, value_parser = parse_count)]
     photons: Option<u64>,
-    /// Photons emitted towards mirrors and glass [default: as --photons].
+    /// Photons emitted towards mirrors and glass [default: as --photons;
+    /// 1e6 for progressive renders given neither].
     #[arg(long, value_parser = parse_count)]
     caustic_photons: Option<u64>,
     /// Camera samples per pixel (a scrambled Sobol sequence, continued
@@ -137,9 +138,11 @@ pub struct RenderArgs {
     /// estimate counts those strictly inside the k-th photon's distance).
     #[arg(long, default_value_t = DEFAULT.k_global as u32, value_parser = count(2, 100_000))]
     k: u32,
-    /// Nearest photons per caustic estimate (at least 2).
-    #[arg(long, default_value_t = DEFAULT.k_caustic as u32, value_parser = count(2, 100_000))]
-    k_caustic: u32,
+    /// Nearest photons per caustic estimate (at least 2) [default: 100; 400
+    /// for progressive renders given no photon counts, whose passes take
+    /// four times the caustic photons].
+    #[arg(long, value_parser = count(2, 100_000))]
+    k_caustic: Option<u32>,
     /// Largest search radius of a global-map estimate, in scene units
     /// [default: 5% of the scene's diagonal].
     #[arg(long, value_parser = parse_radius)]
@@ -208,7 +211,6 @@ impl RenderArgs {
             alpha: self.alpha,
             seed: self.seed,
             k_global: self.k as usize,
-            k_caustic: self.k_caustic as usize,
             r_global: self.max_radius,
             r_caustic: self.caustic_radius,
             gather_rays: self.gather_rays,
@@ -235,6 +237,7 @@ impl RenderArgs {
             resume: self.resume,
             photons: self.photons,
             caustic_photons: self.caustic_photons,
+            k_caustic: self.k_caustic.map(|k| k as usize),
             spp: self.spp,
             width: self.width,
             height: self.height,
