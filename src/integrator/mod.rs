@@ -16,6 +16,7 @@ pub mod mis;
 pub mod path;
 pub mod photon;
 pub mod unseen;
+pub mod volgather;
 pub mod volpath;
 pub mod volphoton;
 pub mod whitted;

@@ -13,20 +13,25 @@
 //! | L …(D\|V)… V (S\|G)* E        | volume map, beam estimate                   |
 //! | L D (S\|G)* E                 | shadow rays at the diffuse or glossy vertex |
 //! | L …(S\|D\|V)… D (S\|G)* E     | surface map (global and caustic photons),   |
-//! |                               | read directly at the diffuse vertex         |
+//! |                               | read directly at the diffuse vertex; with   |
+//! |                               | final gathering, L … D S* D (S\|G)* E by    |
+//! |                               | gather rays instead ([`super::volgather`])  |
 //! | L S+ G (S\|G)* E              | emission met after the specular chain       |
 //!
 //! Transmittance along camera segments is exact in both kinds of media
 //! (a heterogeneous one's integrated along its grid's cells); shadow rays
 //! estimate it by ratio tracking in heterogeneous ones. Surfaces behind a
-//! medium are seen through it. The maps are read directly (no final gathering), so their
-//! radii shrink from pass to pass as progressive photon mapping's do.
+//! medium are seen through it. The maps are read directly, so their
+//! radii shrink from pass to pass as progressive photon mapping's do; with
+//! final gathering, the light of diffuse lobes' paths through the
+//! irradiance cache at the gather rays' ends.
 
 use super::volpath::{emitted_part, roulette, sample_li_everywhere, surface_light, transmittance};
 use super::{Context, Integrator, Part};
 use crate::material::Transport;
 use crate::math::{max_component, Color, Ray};
 use crate::medium::{Media, Medium, Steps};
+use crate::photon::irradiance_cache::IrradianceCache;
 use crate::photon::map::{PhotonMap, Scratch};
 use crate::photon::volume_map::VolumeMap;
 use crate::sampling::next_2d;
@@ -41,9 +46,16 @@ const MAX_EVENTS: u32 = 256;
 pub struct VolPhotonIntegrator<'a> {
     pub scene: &'a Scene,
     pub media: &'a Media,
-    /// Photons on diffuse surfaces: every path but light straight from a
-    /// light.
+    /// Photons on diffuse surfaces, read directly at a diffuse camera
+    /// vertex: every path but light straight from a light; with `cache`,
+    /// only those whose last vertex but specular ones was not a diffuse
+    /// lobe's.
     pub surface: &'a PhotonMap,
+    /// Final gathering: the irradiance of every surface photon, read at
+    /// the gather rays' ends ([`super::volgather`]); `None`: none.
+    pub cache: Option<&'a IrradianceCache>,
+    /// Gather rays per diffuse camera vertex.
+    pub gather_rays: u32,
     /// Photons scattered in media after a diffuse or medium vertex.
     pub volume: &'a VolumeMap,
     /// Photons scattered in media straight after mirrors and glass.
@@ -130,6 +142,10 @@ impl VolPhotonIntegrator<'_> {
                     let r =
                         self.surface.radiance_cone(hit.point, frame.n, rho, self.k, self.r_max, &mut thread.scratch);
                     reflected += ctx.checked(r, "surface map");
+                    if let Some(cache) = self.cache {
+                        let g = self.gather(cache, &hit, frame.n, medium, ctx);
+                        reflected += rho * g;
+                    }
                 }
                 radiance += throughput * reflected;
             }

@@ -6,7 +6,7 @@ use super::facing::FacingTrees;
 use super::map::{in_front, PhotonMap, Scratch, NORMAL_COSINE};
 use super::morton::bounds;
 use super::spots::SpotPoint;
-use super::{normal_times_127, prefetch, quantize_normal};
+use super::{normal_times_127, prefetch, quantize_normal, Photon};
 use crate::math::Color;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -195,6 +195,10 @@ fn reach2(r2: f32, count: usize, k: usize, r_max: f32) -> f32 {
     4.0 * needed.min(4.0 * r_max * r_max)
 }
 
+/// The irradiance straight from the lights at a cache point: its index
+/// and the photon it stands at.
+pub type DirectIrradiance<'a> = dyn Fn(u64, &Photon) -> Color + Sync + 'a;
+
 impl IrradianceCache {
     /// Precomputes irradiance at every `stride`-th photon of `map` from its
     /// `k` nearest within `r_max`.
@@ -207,15 +211,15 @@ impl IrradianceCache {
     /// radius r around x, on the plane of normal n, that lies on x's own
     /// surface (at least a quarter, so that a sliver of surface does not
     /// turn its few photons into a spike); with `direct`, each plus
-    /// `direct(i, x, n)`, the irradiance straight from the lights at the
-    /// `i`-th point (a map that holds no photon's first hit).
+    /// `direct(i, photon)`, the irradiance straight from the lights at the
+    /// `i`-th point, the place of that photon (a map that holds no photon's first hit).
     pub fn build_with(
         map: &PhotonMap,
         stride: usize,
         k: usize,
         r_max: f32,
         coverage: &(dyn Fn(Vec3, Vec3, f32) -> f32 + Sync),
-        direct: Option<&(dyn Fn(u64, Vec3, Vec3) -> Color + Sync)>,
+        direct: Option<&DirectIrradiance<'_>>,
     ) -> Self {
         let stride = stride.max(1);
         // Rayon hands each piece of work it splits off a fresh scratch, and
@@ -243,7 +247,7 @@ impl IrradianceCache {
                         e /= coverage(p.position(), n, r2.sqrt()).clamp(0.25, 1.0);
                     }
                     if let Some(direct) = direct {
-                        e += direct(i as u64, p.position(), n);
+                        e += direct(i as u64, p);
                     }
                     let point = CachePoint {
                         position: p.position().to_array(),

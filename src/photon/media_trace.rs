@@ -17,6 +17,11 @@
 //!   caustics and volume caustics, each path at its first non-specular
 //!   vertex.
 //!
+//! Surface photons whose last vertex other than a mirror, glass or
+//! index-matched crossing was a diffuse lobe's are kept apart
+//! (`after_diffuse`): final gathering from a diffuse camera vertex counts
+//! their paths, the rest are read there directly.
+//!
 //! As in [`super::trace`], every photon draws from its own random stream
 //! and blocks are kept in order: the same photons on any number of threads.
 
@@ -43,7 +48,12 @@ const MAX_PROBE: u32 = 64;
 /// What a pass through a scene with media stored.
 #[derive(Debug, Default)]
 pub struct MediaPhotons {
+    /// Surface photons after a medium vertex, a glossy lobe, or only
+    /// mirrors and glass.
     pub surface: Vec<Photon>,
+    /// Surface photons whose last vertex but specular ones was a diffuse
+    /// lobe's.
+    pub after_diffuse: Vec<Photon>,
     pub volume: Vec<VolumePhoton>,
     pub emitted: u64,
     pub rays: u64,
@@ -95,6 +105,7 @@ pub fn trace_media_pass(
     let mut all = MediaPhotons { emitted: n, ..Default::default() };
     for b in blocks {
         all.surface.extend(b.surface);
+        all.after_diffuse.extend(b.after_diffuse);
         all.volume.extend(b.volume);
         all.rays += b.rays;
     }
@@ -116,6 +127,8 @@ fn trace_photon(
     let (mut medium, mut rays) = start_medium(scene, media, &ray, departure);
     // Specular vertices so far, and whether there was nothing else.
     let (mut specular, mut only_specular) = (0u32, true);
+    // Whether the last vertex but specular ones was a diffuse lobe's.
+    let mut after_diffuse = false;
     for _ in 0..MAX_EVENTS {
         rays += 1;
         let hit = scene.intersect(&ray, departure);
@@ -138,6 +151,7 @@ fn trace_photon(
                         return rays;
                     }
                     only_specular = false;
+                    after_diffuse = false;
                     // The albedo (the collision's weight) is the chance
                     // to go on; survivors carry their power before it.
                     let q = max_component(weight).min(1.0);
@@ -161,7 +175,11 @@ fn trace_photon(
                 Pass::Caustic => specular > 0,
             };
             if store && max_component(power) > 0.0 {
-                out.surface.push(Photon::new(hit.point, power, frame.n));
+                let photon = with_medium(Photon::new(hit.point, power, frame.n), medium);
+                match after_diffuse {
+                    true => out.after_diffuse.push(photon),
+                    false => out.surface.push(photon),
+                }
             }
         }
         let wo = frame.to_local(-ray.dir);
@@ -193,6 +211,9 @@ fn trace_photon(
             false if pass == Pass::Caustic => return rays,
             false => only_specular = false,
         }
+        if scatter.lobe != Lobe::Specular {
+            after_diffuse = scatter.lobe == Lobe::Diffuse;
+        }
         power *= scatter.weight / p;
         if smooth {
             power *= hit.adjoint_correction(-ray.dir, dir);
@@ -205,6 +226,25 @@ fn trace_photon(
         (ray, departure) = (next, Some(dep));
     }
     rays
+}
+
+/// The most media a scene may have for its surface photons to say which
+/// medium they arrived through ([`medium_of`]).
+pub const MAX_NAMED_MEDIA: usize = 254;
+
+/// `photon`, marked with the medium it arrived through (in the fourth
+/// byte of its normal, which nothing else reads): 0 for none, else the
+/// medium's index plus one; 0 too past [`MAX_NAMED_MEDIA`].
+fn with_medium(mut photon: Photon, medium: Option<u32>) -> Photon {
+    let code = medium.filter(|&m| (m as usize) < MAX_NAMED_MEDIA).map_or(0, |m| m + 1);
+    photon.normal[3] = code as u8 as i8;
+    photon
+}
+
+/// The medium on the side of its surface that a surface photon of a scene
+/// with at most [`MAX_NAMED_MEDIA`] media arrived from.
+pub fn medium_of(photon: &Photon) -> Option<u32> {
+    (photon.normal[3] as u8 as u32).checked_sub(1)
 }
 
 /// The medium a photon leaving its light along `ray` starts in: the side

@@ -8,22 +8,33 @@
 //! disk about the ray, whose variance grows as 1 / r² and bias shrinks as
 //! r², as a surface estimate's (Knaus and Zwicker 2011; Jarosz,
 //! Nowrouzezahrai et al. 2011 for beams).
+//!
+//! With final gathering (`--gather-rays` above 0), the surface photons
+//! after a diffuse lobe are left out of the map read at camera vertices
+//! and all of them go into an irradiance cache that the gather rays read
+//! ([`crate::integrator::volphoton`]).
 
 use super::camera_pass::CameraPass;
 use super::method::shoot;
-use super::photon_stage::{pass_seed, shrink, Estimates};
+use super::photon_stage::{pass_seed, shrink, Estimates, CACHE_SHADOW_RAYS, COVERAGE_SAMPLES, GLOBAL_GRID_CELL};
 use crate::film::Film;
+use crate::integrator::volgather::direct_irradiance_in_media;
 use crate::integrator::volphoton::VolPhotonIntegrator;
+use crate::integrator::Context;
 use crate::medium::Media;
-use crate::photon::aims::specular_targets;
+use crate::photon::aims::{disk_coverage, specular_targets};
+use crate::photon::irradiance_cache::IrradianceCache;
 use crate::photon::map::PhotonMap;
-use crate::photon::media_trace::trace_media_pass;
+use crate::photon::media_trace::{medium_of, trace_media_pass, MAX_NAMED_MEDIA};
 use crate::photon::trace::Pass;
 use crate::photon::volume_map::VolumeMap;
+use crate::photon::Photon;
 use crate::progress::{Mode, Phase};
-use crate::render::settings::Settings;
+use crate::render::settings::{cache_stride, Settings};
+use crate::sampling::{stream, Domain};
 use crate::scene::Scene;
-use crate::stats::Stats;
+use crate::stats::{Counters, Stats};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 /// Nearest neighbours that set a volume photon's radius (Jarosz et al.
@@ -69,10 +80,25 @@ pub fn media_pass(
     let t = Instant::now();
     let narrow = shrink(settings.alpha, camera.pass as u32).sqrt() as f32;
     let r_volume = settings.r_global(scene.diagonal());
+    let gathering =
+        settings.gather_rays > 0 && !global.after_diffuse.is_empty() && media.media.len() <= MAX_NAMED_MEDIA;
     let mut surface = global.surface;
     surface.extend(caustic.surface);
-    let (surface, (volume, volume_caustic)) = rayon::join(
-        || PhotonMap::build(surface),
+    let mut after_diffuse = global.after_diffuse;
+    let everything = if gathering {
+        after_diffuse.extend_from_slice(&surface);
+        after_diffuse
+    } else {
+        surface.extend(after_diffuse);
+        Vec::new()
+    };
+    let ((surface, cache_map), (volume, volume_caustic)) = rayon::join(
+        || {
+            rayon::join(
+                || PhotonMap::build(surface),
+                || gathering.then(|| PhotonMap::build_for_photon_lookups(everything, est.r_global * GLOBAL_GRID_CELL)),
+            )
+        },
         || {
             rayon::join(
                 || VolumeMap::build(global.volume, VOLUME_K, r_volume, narrow),
@@ -81,13 +107,43 @@ pub fn media_pass(
         },
     );
     stats.tree_time += t.elapsed();
-    stats.global_stored = surface.len() + volume.len();
+    let t = Instant::now();
+    // The cache's estimates near an edge or a contact are divided by the
+    // part of their disk on their surface, and the lights' own irradiance
+    // added by shadow rays, as in a scene without media; those carry the
+    // transmittance from the medium each photon arrived through.
+    let coverage = |x, n, r| disk_coverage(scene, x, n, r, COVERAGE_SAMPLES);
+    let shadow_rays = AtomicU64::new(0);
+    let direct = |i: u64, p: &Photon| {
+        let mut rng = stream(seed, Domain::CacheDirect, i);
+        let mut counters = Counters::default();
+        let mut ctx = Context { rng: &mut rng, counters: &mut counters, pixel: i };
+        let (x, n, m) = (p.position(), p.surface_normal(), medium_of(p));
+        let e = direct_irradiance_in_media(scene, media, x, n, m, CACHE_SHADOW_RAYS, &mut ctx);
+        shadow_rays.fetch_add(counters.rays, Ordering::Relaxed);
+        e
+    };
+    let cache = cache_map.as_ref().map(|map| {
+        let stride = settings.cache_stride.unwrap_or_else(|| cache_stride(est.k_global, map.len()));
+        IrradianceCache::build_with(map, stride, est.k_global, est.r_global, &coverage, Some(&direct))
+    });
+    stats.cache_rays += shadow_rays.into_inner();
+    let cache = cache.filter(|c| !c.is_empty());
+    stats.cache_time += t.elapsed();
+    stats.cache_points = cache.as_ref().map_or(0, |c| c.len());
+    stats.global_stored = cache_map.as_ref().map_or(surface.len(), |m| m.len()) + volume.len();
     stats.caustic_stored = volume_caustic.len();
-    stats.map_bytes = surface.memory_bytes() + volume.memory_bytes() + volume_caustic.memory_bytes();
+    stats.map_bytes = surface.memory_bytes()
+        + cache_map.as_ref().map_or(0, |m| m.memory_bytes())
+        + volume.memory_bytes()
+        + volume_caustic.memory_bytes();
+    drop(cache_map);
     let integrator = VolPhotonIntegrator {
         scene,
         media,
         surface: &surface,
+        cache: cache.as_ref(),
+        gather_rays: settings.gather_rays,
         volume: &volume,
         volume_caustic: &volume_caustic,
         k: est.k_global,

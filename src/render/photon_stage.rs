@@ -13,6 +13,7 @@ use crate::photon::irradiance_cache::IrradianceCache;
 use crate::photon::map::PhotonMap;
 use crate::photon::spots::{bright_spots, Spot};
 use crate::photon::trace::{trace_pass_with, Pass};
+use crate::photon::Photon;
 use crate::progress::{Mode, Phase};
 use crate::render::settings::{cache_stride, Settings};
 use crate::sampling::{stream, Domain};
@@ -244,10 +245,11 @@ pub fn photon_pass(
     // The global map holds no photon's first hit: the cache adds the
     // direct light by shadow rays (counted, whichever thread casts them).
     let shadow_rays = AtomicU64::new(0);
-    let direct = |i: u64, x, n| {
+    let direct = |i: u64, p: &Photon| {
         let mut rng = stream(seed, Domain::CacheDirect, i);
         let mut counters = Counters::default();
         let mut ctx = Context { rng: &mut rng, counters: &mut counters, pixel: i };
+        let (x, n) = (p.position(), p.surface_normal());
         let e = direct_irradiance(scene, x, n, CACHE_SHADOW_RAYS, settings.skip, &mut ctx);
         shadow_rays.fetch_add(counters.rays, Ordering::Relaxed);
         e
@@ -269,11 +271,11 @@ pub fn photon_pass(
 }
 
 /// Shadow rays per area light for a cache point's direct irradiance.
-const CACHE_SHADOW_RAYS: u32 = 16;
+pub(super) const CACHE_SHADOW_RAYS: u32 = 16;
 
 /// Rays measuring the part of an estimate's disk that lies on its surface
 /// (where the disk holds another surface's photons).
-const COVERAGE_SAMPLES: u32 = 32;
+pub(super) const COVERAGE_SAMPLES: u32 = 32;
 
 /// The global map's grid cells, as a fraction of its radius cap: sized
 /// for the radius its estimates need (the k-th photon's distance, a few

@@ -1,0 +1,183 @@
+//! Final gathering at a diffuse camera vertex in a scene with media
+//! (Jensen 1996's final gather, carried through media as Jensen and
+//! Christensen 1998 do). The light a diffuse vertex x reflects is split by
+//! the last vertex of its light path before x that is not a mirror, glass
+//! or index-matched crossing (notes/method.md §8):
+//!
+//! | that vertex              | estimator at x                               |
+//! |--------------------------|----------------------------------------------|
+//! | the light                | shadow rays (L x), the surface map (L S+ x)  |
+//! | a medium vertex          | the surface map, read directly               |
+//! | a glossy lobe            | the surface map, read directly               |
+//! | a diffuse lobe, at y     | gather rays: cosine directions from x,      |
+//! |                          | through mirrors, glass and media to y        |
+//!
+//! The photon pass keeps the last row's photons apart
+//! ([`crate::photon::media_trace`]: `after_diffuse`), so the map read at x
+//! holds only the others'. A gather ray carries the transmittance of the
+//! media it crosses and what mirrors and glass let through; at y it takes
+//! y's diffuse lobe times the irradiance there, read from the irradiance
+//! cache of all surface photons, to which each cache point adds the
+//! lights' own by shadow rays carrying the transmittance from the medium
+//! its photon arrived through ([`direct_irradiance_in_media`]). Light scattered in a medium along
+//! the gather ray is the surface map's at x (a medium vertex's row), so
+//! the gather ray needs no beam estimate.
+
+use super::volpath::transmittance;
+use super::volphoton::VolPhotonIntegrator;
+use super::Context;
+use crate::material::Transport;
+use crate::math::{max_component, Color, Frame, Ray};
+use crate::medium::Media;
+use crate::photon::irradiance_cache::IrradianceCache;
+use crate::sampling::{cosine_hemisphere, next_2d, stratified_2d};
+use crate::scene::{Hit, Scene};
+use crate::shape::Departure;
+use rand::RngExt;
+use std::f32::consts::PI;
+
+/// A gather ray's events (surfaces met, crossings) are cut after this
+/// many: light trapped by total internal reflection, a negligible share.
+const MAX_GATHER_EVENTS: u32 = 24;
+
+impl VolPhotonIntegrator<'_> {
+    /// Radiance a diffuse vertex `hit` (normal `n`, in medium `medium` on
+    /// the side the camera path arrived from) reflects of light whose last
+    /// non-specular vertex was a diffuse lobe's, over its albedo: the mean
+    /// of the gather rays' radiance.
+    pub(super) fn gather(
+        &self,
+        cache: &IrradianceCache,
+        hit: &Hit,
+        n: glam::Vec3,
+        medium: Option<u32>,
+        ctx: &mut Context,
+    ) -> Color {
+        let count = self.gather_rays;
+        if count == 0 {
+            return Color::ZERO;
+        }
+        let frame = Frame::from_normal(n);
+        let mut sum = Color::ZERO;
+        for g in 0..count {
+            let dir = frame.to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(ctx.rng)))).normalize();
+            // About a shading normal a gather ray may point into the
+            // surface: it gathers nothing.
+            if !(dir.dot(n) > 0.0) || (hit.shading_normal != hit.normal && !hit.leaves_as(-n, dir, true)) {
+                continue;
+            }
+            let start = self.media.after(medium, hit.prim, hit.normal, dir);
+            let (ray, dep) = hit.spawn(dir);
+            sum += self.gather_ray(cache, ray, dep, start, ctx);
+        }
+        sum / count as f32
+    }
+
+    /// Radiance arriving along one gather ray from diffuse lobes' light
+    /// (see the module's table): followed through mirrors, glass and
+    /// index-matched crossings, with the media's transmittance.
+    fn gather_ray(
+        &self,
+        cache: &IrradianceCache,
+        mut ray: Ray,
+        mut dep: Departure,
+        mut medium: Option<u32>,
+        ctx: &mut Context,
+    ) -> Color {
+        let (scene, media) = (self.scene, self.media);
+        let mut weight = Color::ONE;
+        let mut found = Color::ZERO;
+        for _ in 0..MAX_GATHER_EVENTS {
+            ctx.counters.rays += 1;
+            let Some(y) = scene.intersect(&ray, Some(dep)) else { break };
+            if let Some(m) = medium {
+                weight *= media.get(m).transmittance(&ray, y.t, ctx.rng);
+            }
+            weight *= scene.transmittance(Some(dep), y.t);
+            if !(max_component(weight) > 0.0) {
+                break;
+            }
+            let material = scene.material_seen(&y, ray.dir);
+            if material.is_emitter() {
+                break;
+            }
+            let (frame, entering) = y.scattering_frame(ray.dir, &material);
+            let wo = frame.to_local(-ray.dir);
+            if material.diffuse_rho().is_some() {
+                let rho = material.diffuse_albedo(wo);
+                let e = self.cached(cache, y.point, frame.n, ctx);
+                found += weight * rho / PI * ctx.checked(e, "gather");
+            }
+            // On through a mirror, glass or an index-matched crossing; a
+            // glossy lobe's light is the surface map's at x.
+            let branches = material.specular_branches(wo, entering, Transport::Radiance);
+            let several = branches.iter().count() > 1;
+            let Some(b) = branches.choose(ctx.rng) else { break };
+            weight *= if several { b.scale } else { b.scale * b.prob };
+            let dir = if b.wi == -wo { ray.dir } else { frame.to_world(b.wi).normalize() };
+            if b.wi != -wo && y.shading_normal != y.normal && !y.leaves_as(ray.dir, dir, b.wi.z > 0.0) {
+                break;
+            }
+            medium = media.after(medium, y.prim, y.normal, dir);
+            (ray, dep) = y.spawn(dir);
+        }
+        found
+    }
+
+    /// The photons' irradiance at `point` from the cache, read from a
+    /// cache point no surface hides from it.
+    fn cached(&self, cache: &IrradianceCache, point: glam::Vec3, n: glam::Vec3, ctx: &mut Context) -> Color {
+        let scene = self.scene;
+        cache.lookup_seen(point, n, cache.locate(point), |from, to| {
+            let (dir, len) = ((to - from).normalize_or_zero(), from.distance(to));
+            ctx.counters.rays += 1;
+            ctx.counters.cache_rays += 1;
+            let blocked = scene.occluded(&Ray::new(from, dir), None, len, None);
+            ctx.counters.cache_hidden += blocked as u64;
+            blocked
+        })
+    }
+}
+
+/// Irradiance at `x`, a point on a surface facing `n` (towards the side
+/// light arrives on, where medium `medium` is), straight from the lights:
+/// `count` shadow rays, each to a light drawn by power, stratified over
+/// its samples, carrying the media's transmittance and what index-matched
+/// surfaces let through. The surface is found by a short ray down onto it
+/// (zero where there is none), as [`super::direct_irradiance`] finds it.
+pub fn direct_irradiance_in_media(
+    scene: &Scene,
+    media: &Media,
+    x: glam::Vec3,
+    n: glam::Vec3,
+    medium: Option<u32>,
+    count: u32,
+    ctx: &mut Context,
+) -> Color {
+    let height = 1e-4 * (1.0 + x.abs().max_element());
+    let Some(hit) = scene.intersect(&Ray::new(x + height * n, -n), None) else {
+        return Color::ZERO;
+    };
+    if hit.t > 2.0 * height || count == 0 {
+        return Color::ZERO;
+    }
+    let mut sum = Color::ZERO;
+    for s in 0..count {
+        let Some((index, chance)) = scene.pick_light_index(ctx.rng.random::<f32>()) else { return Color::ZERO };
+        let light = &scene.lights[index];
+        let Some(inc) = light.sample_li(hit.point, n, stratified_2d(s, count, next_2d(ctx.rng))) else { continue };
+        let cos = inc.dir.dot(n);
+        if !(cos > 0.0) || inc.intensity == Color::ZERO {
+            continue;
+        }
+        if hit.shading_normal != hit.normal && !hit.leaves_as(-n, inc.dir, true) {
+            continue;
+        }
+        let (shadow, dep) = hit.spawn(inc.dir);
+        let reach = inc.target.map_or(f32::INFINITY, |y| (y - shadow.origin).length());
+        let start = media.after(medium, hit.prim, hit.normal, inc.dir);
+        let tr = transmittance(scene, media, shadow, Some(dep), reach, inc.prim, start, ctx);
+        sum += inc.intensity * tr * (cos / chance);
+    }
+    sum / count as f32
+}
