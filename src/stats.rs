@@ -121,8 +121,11 @@ stats! {
     /// Pixels on the rim of a light's image, sampled with `edge_spp`.
     edge_pixels: usize => last,
     /// The emitted part's samples in each of them (`Settings::edge_spp`,
-    /// or fewer where the rims are many).
+    /// or fewer where the rims are many), on average (rounded down) and
+    /// at most (more than the average where the rims' share went by their
+    /// probes' spread: render::rims).
     edge_spp: u32 => last,
+    edge_spp_max: u32 => last,
     photon_time: Duration => sum,
     /// The map build: the photon maps (the caustic map's Morton sort and
     /// kd-tree, both maps' grids), then the irradiance cache (estimates at

@@ -47,7 +47,12 @@ impl Summary<'_> {
             own.camera,
             st.shadow_rays
         ));
-        if s.edge_pixels > 0 {
+        if s.edge_pixels > 0 && s.edge_spp_max > s.edge_spp {
+            out.push(format!(
+                "               {} pixels on a light's rim took {} extra samples on average, up to {}",
+                s.edge_pixels, s.edge_spp, s.edge_spp_max
+            ));
+        } else if s.edge_pixels > 0 {
             out.push(format!(
                 "               {} pixels on a light's rim took {} extra samples",
                 s.edge_pixels, s.edge_spp

@@ -4,7 +4,7 @@
 //! estimate the emitted part with `edge_spp` samples of their own. Each pixel has its own random
 //! stream per pass, so rows can run on any thread in any order.
 
-use super::rims::light_rims;
+use super::rims::{light_rims, Rims};
 use crate::camera::Camera;
 use crate::film::Film;
 use crate::integrator::{Context, Integrator, Part};
@@ -48,8 +48,10 @@ pub struct Shot {
     pub counters: Counters,
     /// Pixels on the rim of a light's image.
     pub edge_pixels: usize,
-    /// The samples of the emitted part each of them took.
+    /// The samples of the emitted part they took, on average (rounded
+    /// down) and at most.
     pub edge_spp: u32,
+    pub edge_spp_max: u32,
 }
 
 /// The random-stream index of a pixel in a pass: passes get disjoint streams.
@@ -76,26 +78,24 @@ fn lens_scramble(scramble: u64) -> u64 {
 /// split estimate changes only its noise, not its mean. Found again every
 /// pass, the probes (four camera rays a pixel) were 16-24% of a
 /// progressive pass's camera pass at 1 spp.
-pub fn camera_pass<I: Integrator>(
-    pass: &CameraPass,
-    integrator: &I,
-    progress: Mode,
-    rims: &mut Option<Vec<bool>>,
-) -> Shot {
+pub fn camera_pass<I: Integrator>(pass: &CameraPass, integrator: &I, progress: Mode, rims: &mut Option<Rims>) -> Shot {
     let camera = &pass.camera;
     let (w, h) = (camera.width, camera.height);
     let spp = pass.spp.max(1);
     let lens = camera.projection.has_lens();
     let mut counters = Counters::default();
-    let rims: &[bool] = rims.get_or_insert_with(|| {
+    let rims = rims.get_or_insert_with(|| {
         if pass.edge_spp > 0 {
             light_rims(camera, integrator, pass.seed, &mut counters)
         } else {
-            vec![false; w as usize * h as usize]
+            Rims::none(w as usize * h as usize)
         }
     });
-    let edge_pixels = rims.iter().filter(|&&r| r).count();
-    let edge_spp = rim_samples(pass.edge_spp, w as usize * h as usize * spp as usize, edge_pixels);
+    let edge_pixels = rims.count();
+    let rim_spp = rims.samples(pass.edge_spp, w as usize * h as usize * spp as usize);
+    let edge_total: u64 = rim_spp.iter().map(|&n| n as u64).sum();
+    let edge_spp = if edge_pixels == 0 { pass.edge_spp } else { (edge_total / edge_pixels as u64) as u32 };
+    let edge_spp_max = rim_spp.iter().copied().max().unwrap_or(0);
     let phase = Phase::start(progress, "camera pass", h as u64);
     let mut film = Film::new(w, h);
     let per_row: Vec<Counters> = film
@@ -142,8 +142,8 @@ pub fn camera_pass<I: Integrator>(
                     sum += integrator.finish(&mut ctx, thread, &mut state).as_dvec3();
                     sum / n as f64
                 };
-                let value = if rims[pixel as usize] {
-                    estimate(Part::Reflected, spp) + estimate(Part::Emitted, edge_spp)
+                let value = if rim_spp[pixel as usize] > 0 {
+                    estimate(Part::Reflected, spp) + estimate(Part::Emitted, rim_spp[pixel as usize])
                 } else {
                     estimate(Part::All, spp)
                 };
@@ -155,36 +155,5 @@ pub fn camera_pass<I: Integrator>(
         .collect();
     phase.finish();
     let counters = per_row.into_iter().fold(counters, Counters::merge);
-    Shot { film, counters, edge_pixels, edge_spp }
-}
-
-/// The emitted part's samples in each of `rims` rim pixels: `asked`, but
-/// no more than the pass's other `samples` spread over the rims (at least
-/// one). The split is worth its cost where a few rim pixels hold most of
-/// the noise (a small bright light, notes/method.md); where a rim runs
-/// along every silhouette (a scene lit by an environment map, 499 to 829
-/// of 48 x 48 pixels in Mitsuba's media tests) 256 samples each made a
-/// pass of 1 spp cost 4.4x as much. Fixed by the rims, not the pass, so
-/// that every pass takes the same count and the Sobol sequence runs on.
-pub(crate) fn rim_samples(asked: u32, samples: usize, rims: usize) -> u32 {
-    if rims == 0 {
-        return asked;
-    }
-    asked.min((samples / rims).clamp(1, u32::MAX as usize) as u32)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::rim_samples;
-
-    /// A few rims take what is asked; many share the pass's other samples;
-    /// every rim takes at least one.
-    #[test]
-    fn rims_take_at_most_the_passs_other_samples() {
-        assert_eq!(rim_samples(256, 800 * 800 * 4, 905), 256);
-        assert_eq!(rim_samples(256, 48 * 48, 499), 4);
-        assert_eq!(rim_samples(256, 48 * 48, 48 * 48), 1);
-        assert_eq!(rim_samples(0, 48 * 48, 10), 0);
-        assert_eq!(rim_samples(256, 10, 0), 256);
-    }
+    Shot { film, counters, edge_pixels, edge_spp, edge_spp_max }
 }

@@ -53,7 +53,7 @@ pub fn media_pass(
     media: &Media,
     camera: &CameraPass,
     progress: Mode,
-    rims: &mut Option<Vec<bool>>,
+    rims: &mut Option<super::Rims>,
     stats: &mut Stats,
 ) -> Film {
     let est = Estimates::progressive(scene, settings, camera.pass as u32);

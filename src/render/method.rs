@@ -114,7 +114,7 @@ pub trait RenderMethod: Sync {
         scene: &Scene,
         camera: &CameraPass,
         progress: Mode,
-        rims: &mut Option<Vec<bool>>,
+        rims: &mut Option<super::Rims>,
         stats: &mut Stats,
     ) -> Film;
 
@@ -139,7 +139,7 @@ pub fn shoot<I: Integrator>(
     camera: &CameraPass,
     integrator: &I,
     progress: Mode,
-    rims: &mut Option<Vec<bool>>,
+    rims: &mut Option<super::Rims>,
     stats: &mut Stats,
 ) -> Film {
     let t = Instant::now();
@@ -148,5 +148,6 @@ pub fn shoot<I: Integrator>(
     stats.camera = shot.counters;
     stats.edge_pixels = shot.edge_pixels;
     stats.edge_spp = shot.edge_spp;
+    stats.edge_spp_max = shot.edge_spp_max;
     shot.film
 }

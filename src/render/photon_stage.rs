@@ -39,7 +39,7 @@ impl RenderMethod for PhotonMapping {
         scene: &Scene,
         camera: &CameraPass,
         progress: Mode,
-        rims: &mut Option<Vec<bool>>,
+        rims: &mut Option<super::Rims>,
         stats: &mut Stats,
     ) -> Film {
         let settings = &self.settings;

@@ -26,7 +26,7 @@ impl RenderMethod for PathTracing {
         scene: &Scene,
         camera: &CameraPass,
         progress: Mode,
-        rims: &mut Option<Vec<bool>>,
+        rims: &mut Option<super::Rims>,
         stats: &mut Stats,
     ) -> Film {
         let integrator = PathIntegrator { scene, shadow_rays: self.shadow_rays, skip: self.skip, mis: true };
@@ -56,7 +56,7 @@ impl RenderMethod for WhittedTracing {
         scene: &Scene,
         camera: &CameraPass,
         progress: Mode,
-        rims: &mut Option<Vec<bool>>,
+        rims: &mut Option<super::Rims>,
         stats: &mut Stats,
     ) -> Film {
         let camera = CameraPass { placement: Placement::JitteredGrid, edge_spp: 0, ..*camera };
