@@ -26,8 +26,9 @@ const CONTRAST: f32 = 16.0;
 /// The rim pixels of a view, with how far apart the emitted light their
 /// probes saw lies: for each pixel 0 where it is no rim, else the largest
 /// value (the largest component) seen by the probes of the pixel and its
-/// eight neighbours less the smallest (always above 0 at a rim: one of
-/// the probes that disagree saw nothing). A sample's spread bounds twice
+/// eight neighbours less the smallest (always above 0 at a rim: where
+/// the probes disagree one saw nothing, else the brightest is `CONTRAST`
+/// times the dimmest). A sample's spread bounds twice
 /// its standard deviation, so it tells which rims are worth samples: a
 /// sun seen through glass spreads 1,000 times as far as a sky seen past a
 /// silhouette.
