@@ -15,9 +15,7 @@
 use photonmap::film::accumulation::Accumulation;
 use photonmap::render::{render_passes, Budget};
 use photonmap::scene::Scene;
-use photonmap::settings::{
-    Settings, PROGRESSIVE_CAUSTIC_PHOTONS, PROGRESSIVE_K_CAUSTIC, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP,
-};
+use photonmap::settings::{progressive_caustics, Settings, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP};
 use plotters::prelude::*;
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -55,10 +53,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let reference = &scoring.reference;
         let file = photonmap::scene::file::load(&s.scene)?;
         let scene = Scene::from_parts(file.parts);
+        let (caustic_photons, k_caustic) = progressive_caustics(scene.media().is_some());
         let settings = Settings {
             photons: PROGRESSIVE_PHOTONS,
-            caustic_photons: PROGRESSIVE_CAUSTIC_PHOTONS,
-            k_caustic: PROGRESSIVE_K_CAUSTIC,
+            caustic_photons,
+            k_caustic,
             spp: PROGRESSIVE_SPP,
             width: reference.width,
             height: reference.height,

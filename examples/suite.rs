@@ -23,7 +23,8 @@ use photonmap::progress::Mode;
 use photonmap::render::{render, render_progressive, Budget};
 use photonmap::scene::Scene;
 use photonmap::settings::{
-    Settings, PROGRESSIVE_CAUSTIC_PHOTONS, PROGRESSIVE_K_CAUSTIC, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP,
+    progressive_caustics, Settings, PROGRESSIVE_CAUSTIC_PHOTONS, PROGRESSIVE_K_CAUSTIC, PROGRESSIVE_PHOTONS,
+    PROGRESSIVE_SPP,
 };
 use photonmap::suite::SuiteScene;
 use std::fmt::Write as _;
@@ -93,13 +94,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             None
         } else {
             let t = Instant::now();
-            let p = Settings {
-                photons: PROGRESSIVE_PHOTONS,
-                caustic_photons: PROGRESSIVE_CAUSTIC_PHOTONS,
-                k_caustic: PROGRESSIVE_K_CAUSTIC,
-                spp: PROGRESSIVE_SPP,
-                ..settings
-            };
+            let (caustic_photons, k_caustic) = progressive_caustics(scene.media().is_some());
+            let p =
+                Settings { photons: PROGRESSIVE_PHOTONS, caustic_photons, k_caustic, spp: PROGRESSIVE_SPP, ..settings };
             let load = std::time::Duration::ZERO;
             let (film, stats) = render_progressive(&scene, &p, Budget::seconds(seconds - load.as_secs_f64()), |_| {});
             let scored = score(&film, t.elapsed().as_secs_f64(), stats.passes as u64)?;
@@ -253,7 +250,8 @@ fn report(rows: &[Row], suite: &[SuiteScene], seconds: f64) -> String {
          tests/data/suite/), with the metric of `photonmap compare`: RMSE over the whole image and the caustic \
          window (scenes/suite/suite.toml), each less the reference's own noise in quadrature; bias is the mean's \
          relative difference. *Default*: photonmap's default settings, timed from loading the scene to the \
-         finished image. *Progressive*: {seconds:.0} s of progressive passes ({} global and {} caustic photons, caustic k {}, and {} spp a pass). \
+         finished image. *Progressive*: {seconds:.0} s of progressive passes ({} global and {} caustic photons, caustic k {} (in a scene with media as many \
+         caustic photons as global ones, k 100), and {} spp a pass). \
          *Mitsuba*: its path tracer at the same wall time, loading included; *ratio*: Mitsuba's error over \
          photonmap's.\n",
         PROGRESSIVE_PHOTONS, PROGRESSIVE_CAUSTIC_PHOTONS, PROGRESSIVE_K_CAUSTIC, PROGRESSIVE_SPP

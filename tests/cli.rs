@@ -236,12 +236,20 @@ fn export_takes_a_negative_origin() {
 /// was given (the caustic count following the global one).
 #[test]
 fn progressive_passes_take_more_caustic_photons_where_given_no_counts() {
+    const FOG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/suite/12-fog-shafts.toml");
     let dir = scratch_dir("cli-progressive-counts");
     let cases: &[(&[&str], &str, &str)] = &[
         (&[], "250000 global, 1000000 caustic", "k_caustic: 400,"),
         (&["--photons", "2e4"], "20000 global, 20000 caustic", "k_caustic: 100,"),
         (&["--caustic-photons", "3e4"], "250000 global, 30000 caustic", "k_caustic: 100,"),
         (&["--k-caustic", "50"], "250000 global, 1000000 caustic", "k_caustic: 50,"),
+        // A caustic photon in a medium goes on through it: not the cheap part there.
+        (&["--scene", FOG, "--integrator", "photon"], "250000 global, 250000 caustic", "k_caustic: 100,"),
+        (
+            &["--scene", FOG, "--integrator", "photon", "--k-caustic", "50"],
+            "250000 global, 250000 caustic",
+            "k_caustic: 50,",
+        ),
     ];
     for (i, (given, photons, k)) in cases.iter().enumerate() {
         let exr = dir.join(format!("p{i}.exr"));

@@ -16,9 +16,7 @@ use crate::output::partial::{read_partial, Manifest, Part, Partial};
 use crate::output::read_exr;
 use crate::progress::Mode;
 use crate::provenance::{settings_key, Provenance};
-use crate::render::settings::{
-    Settings, DEFAULT, PROGRESSIVE_CAUSTIC_PHOTONS, PROGRESSIVE_K_CAUSTIC, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP,
-};
+use crate::render::settings::{progressive_caustics, Settings, DEFAULT, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP};
 use crate::render::{drive, Budget, Method, Observer, Plan, Stopped};
 use crate::scene::Eye;
 use crate::stats::counted;
@@ -141,16 +139,13 @@ pub fn run(req: Request) -> Result<Outcome, Error> {
         false => (req.photons.unwrap_or(DEFAULT.photons), req.spp.unwrap_or(file_spp)),
     };
     // A progressive pass given no photon counts takes more caustic photons
-    // at a k that keeps the estimates' disks (PROGRESSIVE_CAUSTIC_PHOTONS).
-    let progressive_caustics = progressive && req.photons.is_none() && req.caustic_photons.is_none();
-    let caustic_photons = match progressive_caustics {
-        true => PROGRESSIVE_CAUSTIC_PHOTONS,
-        false => req.caustic_photons.unwrap_or(photons),
+    // at a k that keeps the estimates' disks, where the scene has no media.
+    let given_no_counts = progressive && req.photons.is_none() && req.caustic_photons.is_none();
+    let (caustic_photons, k_caustic) = match given_no_counts {
+        true => progressive_caustics(scene.media().is_some()),
+        false => (req.caustic_photons.unwrap_or(photons), DEFAULT.k_caustic),
     };
-    let k_caustic = req.k_caustic.unwrap_or(match progressive_caustics {
-        true => PROGRESSIVE_K_CAUSTIC,
-        false => DEFAULT.k_caustic,
-    });
+    let k_caustic = req.k_caustic.unwrap_or(k_caustic);
     let settings = Settings { method, photons, caustic_photons, k_caustic, spp, width, height, ..req.settings };
     if let Some(reference) = &reference {
         reference_fits(reference, width, height)?;

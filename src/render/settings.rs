@@ -102,6 +102,19 @@ pub const PROGRESSIVE_SPP: u32 = 1;
 pub const PROGRESSIVE_CAUSTIC_PHOTONS: u64 = 1_000_000;
 pub const PROGRESSIVE_K_CAUSTIC: usize = 400;
 
+/// Caustic photons and the caustic k of a progressive pass given no
+/// counts. In a scene with media a caustic photon is not cheap: it is
+/// traced on through the medium and stores volume photons on its way, so
+/// four times as many doubled the pass of suite scene 13-volume-caustic
+/// (100², 2 passes: 1.98 s against 0.94 s). There a pass keeps
+/// [`PROGRESSIVE_PHOTONS`] at the classic k.
+pub fn progressive_caustics(has_media: bool) -> (u64, usize) {
+    match has_media {
+        true => (PROGRESSIVE_PHOTONS, DEFAULT.k_caustic),
+        false => (PROGRESSIVE_CAUSTIC_PHOTONS, PROGRESSIVE_K_CAUSTIC),
+    }
+}
+
 /// The default [`Settings::caustic_reuse`].
 pub const CAUSTIC_REUSE: f32 = 0.1;
 
