@@ -16,11 +16,12 @@
 
 use super::camera_pass::CameraPass;
 use super::method::shoot;
-use super::photon_stage::{pass_seed, shrink, Estimates, CACHE_SHADOW_RAYS, COVERAGE_SAMPLES, GLOBAL_GRID_CELL};
+use super::photon_stage::{
+    cache_direct, pass_seed, shrink, Estimates, CACHE_SHADOW_RAYS, COVERAGE_SAMPLES, GLOBAL_GRID_CELL,
+};
 use crate::film::Film;
 use crate::integrator::volgather::direct_irradiance_in_media;
 use crate::integrator::volphoton::VolPhotonIntegrator;
-use crate::integrator::Context;
 use crate::medium::Media;
 use crate::photon::aims::{disk_coverage, specular_targets};
 use crate::photon::irradiance_cache::IrradianceCache;
@@ -31,10 +32,9 @@ use crate::photon::volume_map::VolumeMap;
 use crate::photon::Photon;
 use crate::progress::{Mode, Phase};
 use crate::render::settings::{cache_stride, Settings};
-use crate::sampling::{stream, Domain};
 use crate::scene::Scene;
-use crate::stats::{Counters, Stats};
-use std::sync::atomic::{AtomicU64, Ordering};
+use crate::stats::Stats;
+use std::sync::atomic::AtomicU64;
 use std::time::Instant;
 
 /// Nearest neighbours that set a volume photon's radius (Jarosz et al.
@@ -115,13 +115,10 @@ pub fn media_pass(
     let coverage = |x, n, r| disk_coverage(scene, x, n, r, COVERAGE_SAMPLES);
     let shadow_rays = AtomicU64::new(0);
     let direct = |i: u64, p: &Photon| {
-        let mut rng = stream(seed, Domain::CacheDirect, i);
-        let mut counters = Counters::default();
-        let mut ctx = Context { rng: &mut rng, counters: &mut counters, pixel: i };
-        let (x, n, m) = (p.position(), p.surface_normal(), medium_of(p));
-        let e = direct_irradiance_in_media(scene, media, x, n, m, CACHE_SHADOW_RAYS, &mut ctx);
-        shadow_rays.fetch_add(counters.rays, Ordering::Relaxed);
-        e
+        cache_direct(seed, i, &shadow_rays, |ctx| {
+            let (x, n, m) = (p.position(), p.surface_normal(), medium_of(p));
+            direct_irradiance_in_media(scene, media, x, n, m, CACHE_SHADOW_RAYS, ctx)
+        })
     };
     let cache = cache_map.as_ref().map(|map| {
         let stride = settings.cache_stride.unwrap_or_else(|| cache_stride(est.k_global, map.len()));

@@ -8,6 +8,7 @@ use super::method::{shoot, Method, MethodSummary, RenderMethod};
 use crate::film::Film;
 use crate::integrator::photon::{PhotonEstimator, PhotonIntegrator};
 use crate::integrator::{direct_irradiance, Context};
+use crate::math::Color;
 use crate::photon::aims::{disk_coverage, needs, specular_targets, Target};
 use crate::photon::irradiance_cache::IrradianceCache;
 use crate::photon::map::PhotonMap;
@@ -246,13 +247,9 @@ pub fn photon_pass(
     // direct light by shadow rays (counted, whichever thread casts them).
     let shadow_rays = AtomicU64::new(0);
     let direct = |i: u64, p: &Photon| {
-        let mut rng = stream(seed, Domain::CacheDirect, i);
-        let mut counters = Counters::default();
-        let mut ctx = Context { rng: &mut rng, counters: &mut counters, pixel: i };
-        let (x, n) = (p.position(), p.surface_normal());
-        let e = direct_irradiance(scene, x, n, CACHE_SHADOW_RAYS, settings.skip, &mut ctx);
-        shadow_rays.fetch_add(counters.rays, Ordering::Relaxed);
-        e
+        cache_direct(seed, i, &shadow_rays, |ctx| {
+            direct_irradiance(scene, p.position(), p.surface_normal(), CACHE_SHADOW_RAYS, settings.skip, ctx)
+        })
     };
     let cache = IrradianceCache::build_with(&global_map, stride, est.k_global, est.r_global, &coverage, Some(&direct));
     let spots = if settings.aimed_rays() > 0 {
@@ -272,6 +269,22 @@ pub fn photon_pass(
 
 /// Shadow rays per area light for a cache point's direct irradiance.
 pub(super) const CACHE_SHADOW_RAYS: u32 = 16;
+
+/// The lights' irradiance at cache point `i` by `irradiance`, drawn from
+/// point i's own stream (the same on any thread) with its shadow rays
+/// counted into `rays`, whichever thread casts them.
+pub(super) fn cache_direct(
+    seed: u64,
+    i: u64,
+    rays: &AtomicU64,
+    irradiance: impl FnOnce(&mut Context) -> Color,
+) -> Color {
+    let mut rng = stream(seed, Domain::CacheDirect, i);
+    let mut counters = Counters::default();
+    let e = irradiance(&mut Context { rng: &mut rng, counters: &mut counters, pixel: i });
+    rays.fetch_add(counters.rays, Ordering::Relaxed);
+    e
+}
 
 /// Rays measuring the part of an estimate's disk that lies on its surface
 /// (where the disk holds another surface's photons).
