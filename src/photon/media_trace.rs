@@ -125,6 +125,15 @@ fn trace_photon(
     out: &mut MediaPhotons,
 ) -> u64 {
     let (mut medium, mut rays) = start_medium(scene, media, &ray, departure);
+    if let Some(m) = medium.filter(|_| from_infinity(scene, ray.origin)) {
+        // Light from infinity crossed the medium it starts in all the
+        // way from there: as a shadow ray towards it leaving the scene in
+        // that medium sees it (none through a homogeneous fog).
+        power *= media.get(m).transmittance(&Ray::new(ray.origin, -ray.dir), f32::INFINITY, rng);
+        if !(max_component(power) > 0.0) {
+            return rays;
+        }
+    }
     // Specular vertices so far, and whether there was nothing else.
     let (mut specular, mut only_specular) = (0u32, true);
     // Whether the last vertex but specular ones was a diffuse lobe's.
@@ -245,6 +254,15 @@ fn with_medium(mut photon: Photon, medium: Option<u32>) -> Photon {
 /// with at most [`MAX_NAMED_MEDIA`] media arrived from.
 pub fn medium_of(photon: &Photon) -> Option<u32> {
     (photon.normal[3] as u8 as u32).checked_sub(1)
+}
+
+/// Whether a photon starting at `origin` comes from a light at infinity:
+/// those start outside the scene's bounds, which hold every other light
+/// ([`crate::light::place_lights`]).
+fn from_infinity(scene: &Scene, origin: glam::Vec3) -> bool {
+    let (lo, hi) = scene.bounds();
+    let margin = glam::Vec3::splat(1e-3 * scene.diagonal());
+    !(origin.cmpge(lo - margin).all() && origin.cmple(hi + margin).all())
 }
 
 /// The medium a photon leaving its light along `ray` starts in: the side
