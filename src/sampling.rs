@@ -175,6 +175,90 @@ pub fn sobol_owen_2d(index: u32, scramble: u64) -> Vec2 {
     Vec2::new(unit(owen_scramble(x, scramble as u32)), unit(owen_scramble(y, (scramble >> 32) as u32)))
 }
 
+/// Two points of [0,1)^2 for photon `index` of the pass whose streams
+/// `seed` keys: the first four dimensions of the Sobol sequence, each
+/// Owen-scrambled (Burley 2020), as (dimensions 0 and 3, dimensions 1
+/// and 2). Each point on its own is uniform, and the first photons of a
+/// pass fill the four-dimensional cube evenly: a light's caustic photons
+/// read through them cover its directions and the aimed disk jointly
+/// stratified (the photons of a sun, a part of the map's directions, still
+/// cover the disk evenly), where random ones leave the Poisson noise of
+/// where they happen to fall. Every 2^32 photons take scrambles of their
+/// own.
+pub fn photon_points(seed: u64, index: u64) -> [Vec2; 2] {
+    let key = splitmix64(seed ^ splitmix64(QUASI_PHOTONS ^ (index >> 32)));
+    let x = sobol_4d(index as u32);
+    let unit = |d: usize| {
+        let scramble = splitmix64(key.wrapping_add(d as u64)) as u32;
+        (owen_scramble(x[d], scramble) >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+    };
+    [Vec2::new(unit(0), unit(3)), Vec2::new(unit(1), unit(2))]
+}
+
+/// Keys [`photon_points`]' scrambles apart from every [`Domain`]'s streams.
+const QUASI_PHOTONS: u64 = 0x0051_0B01;
+
+/// The generator matrices of the Sobol sequence's first four dimensions,
+/// as 32 direction numbers each (bit 31 the coarsest): the van der Corput
+/// sequence, then the primitive polynomials x + 1, x^2 + x + 1 and
+/// x^3 + x + 1 with initial numbers 1; 1, 3; 1, 3, 1 (Joe & Kuo 2008,
+/// "Constructing Sobol sequences with better two-dimensional
+/// projections", their table's first rows), extended by Bratley & Fox's
+/// recurrence m_k = 2 a_1 m_{k-1} ^ ... ^ 2^s m_{k-s} ^ m_{k-s}.
+const SOBOL_4D: [[u32; 32]; 4] = {
+    // (degree s, the polynomial's inner coefficients a_1 .. a_{s-1} as
+    // bits, a_1 highest; the initial m_1 .. m_s).
+    const POLYS: [(usize, u32, [u32; 3]); 3] = [(1, 0, [1, 0, 0]), (2, 1, [1, 3, 0]), (3, 1, [1, 3, 1])];
+    let mut v = [[0u32; 32]; 4];
+    let mut k = 0;
+    while k < 32 {
+        v[0][k] = 1 << (31 - k);
+        k += 1;
+    }
+    let mut d = 0;
+    while d < 3 {
+        let (s, a, init) = POLYS[d];
+        let mut m = [0u64; 32];
+        let mut k = 0;
+        while k < 32 {
+            m[k] = if k < s {
+                init[k] as u64
+            } else {
+                let mut x = m[k - s] ^ (m[k - s] << s);
+                let mut j = 1;
+                while j < s {
+                    if (a >> (s - 1 - j)) & 1 == 1 {
+                        x ^= m[k - j] << j;
+                    }
+                    j += 1;
+                }
+                x
+            };
+            v[d + 1][k] = (m[k] << (31 - k)) as u32;
+            k += 1;
+        }
+        d += 1;
+    }
+    v
+};
+
+/// Point `index` of the Sobol sequence's first four dimensions, unscrambled,
+/// as 32-bit fractions.
+fn sobol_4d(index: u32) -> [u32; 4] {
+    let mut x = [0u32; 4];
+    let (mut i, mut k) = (index, 0);
+    while i != 0 {
+        if i & 1 == 1 {
+            for (xd, v) in x.iter_mut().zip(&SOBOL_4D) {
+                *xd ^= v[k];
+            }
+        }
+        i >>= 1;
+        k += 1;
+    }
+    x
+}
+
 /// `index` shuffled by nested uniform scrambling of its bits (Burley 2020,
 /// "Practical Hash-based Owen Scrambling", JCGT 9(4), section 4): each
 /// aligned block of 2^m indices goes to an aligned block of 2^m, so a
@@ -253,6 +337,73 @@ impl Discrete {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The unscrambled generator gives Joe & Kuo's first points (in index
+    /// order, not their Gray-code order).
+    #[test]
+    fn the_four_dimensional_sobol_points_are_joe_and_kuos() {
+        let f = |x: [u32; 4]| x.map(|v| v as f64 / 4_294_967_296.0);
+        assert_eq!(f(sobol_4d(0)), [0.0; 4]);
+        assert_eq!(f(sobol_4d(1)), [0.5; 4]);
+        assert_eq!(f(sobol_4d(2)), [0.25, 0.75, 0.75, 0.75]);
+        assert_eq!(f(sobol_4d(3)), [0.75, 0.25, 0.25, 0.25]);
+        assert_eq!(f(sobol_4d(4)), [0.125, 0.625, 0.375, 0.125]);
+        assert_eq!(f(sobol_4d(6)), [0.375, 0.375, 0.625, 0.875]);
+    }
+
+    /// A photon's points, for any pass's seed and block of 2^m photons
+    /// from a multiple of 2^m: in four dimensions every box of volume
+    /// 2^(3-m) (2^-a0 x 2^-a1 x 2^-a2 x 2^-a3, a0 + .. + a3 = m - 3) holds
+    /// 8 of them (a (3, m, 4)-net: the Sobol sequence's t for these
+    /// polynomials, 0 + 0 + 1 + 2), the aimed disk's point with the
+    /// direction's first coordinate every box of volume 2^(1-m) holds 2,
+    /// and each point alone lies in [0, 1)^2.
+    #[test]
+    fn photon_points_are_a_four_dimensional_net() {
+        fn boxes(parts: usize, total: u32, f: &mut dyn FnMut(&[u32])) {
+            fn go(a: &mut Vec<u32>, parts: usize, left: u32, f: &mut dyn FnMut(&[u32])) {
+                if a.len() + 1 == parts {
+                    a.push(left);
+                    f(a);
+                    a.pop();
+                    return;
+                }
+                for x in 0..=left {
+                    a.push(x);
+                    go(a, parts, left - x, f);
+                    a.pop();
+                }
+            }
+            go(&mut Vec::new(), parts, total, f);
+        }
+        for seed in [0u64, 7, u64::MAX] {
+            for m in 3..=9u32 {
+                let n = 1u64 << m;
+                for block in [0u64, 3] {
+                    let pts: Vec<[f32; 4]> = (0..n)
+                        .map(|i| {
+                            let [a, b] = photon_points(seed, block * n + i);
+                            for p in [a, b] {
+                                assert!(p.cmpge(Vec2::ZERO).all() && p.cmplt(Vec2::ONE).all(), "{p}");
+                            }
+                            [a.x, b.x, b.y, a.y]
+                        })
+                        .collect();
+                    for (dims, t) in [(&[0usize, 1, 2, 3][..], 3u32), (&[0, 1, 2][..], 1)] {
+                        boxes(dims.len(), m - t, &mut |a| {
+                            let mut count = std::collections::HashMap::new();
+                            for p in &pts {
+                                let key: Vec<u32> =
+                                    dims.iter().zip(a).map(|(&d, &ad)| (p[d] * (1u32 << ad) as f32) as u32).collect();
+                                *count.entry(key).or_insert(0u32) += 1;
+                            }
+                            assert!(count.values().all(|&c| c == 1 << t), "seed {seed} m {m} dims {dims:?} {a:?}");
+                        });
+                    }
+                }
+            }
+        }
+    }
 
     /// Every block of 2^m consecutive points from a multiple of 2^m holds
     /// one point in each cell of every 2^a x 2^b grid (a + b = m), for any

@@ -7,7 +7,7 @@ use super::{
     Source,
 };
 use crate::math::{Color, Ray, Vertex};
-use crate::sampling::Rng;
+use crate::sampling::{next_2d, Rng};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -44,7 +44,7 @@ impl Source for Directional {
 
     #[inline]
     fn sample_le_towards(&self, aim: &impl Aim, rng: &mut Rng) -> Option<Aimed> {
-        Some(aimed_across(self.direction, self.irradiance, self.reach.0, aim, rng))
+        Some(aimed_across(self.direction, self.irradiance, self.reach.0, aim, next_2d(rng)))
     }
 
     fn power(&self) -> Color {

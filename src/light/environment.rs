@@ -80,13 +80,20 @@ impl Source for Environment {
     /// L / pdf along it.
     #[inline]
     fn sample_le_towards(&self, aim: &impl Aim, rng: &mut Rng) -> Option<Aimed> {
-        let (towards, pdf) = self.map.sample(next_2d(rng));
+        let u = [next_2d(rng), next_2d(rng)];
+        self.sample_le_towards_at(aim, u, rng)
+    }
+
+    /// The direction from `u[0]`, the start on the aimed disk from `u[1]`.
+    #[inline]
+    fn sample_le_towards_at(&self, aim: &impl Aim, u: [Vec2; 2], _rng: &mut Rng) -> Option<Aimed> {
+        let (towards, pdf) = self.map.sample(u[0]);
         if !(pdf > 0.0) {
             return None;
         }
         let direction = -towards;
         let plane = self.reach.upstream(direction);
-        Some(aimed_across(direction, self.map.eval(towards) / pdf, plane, aim, rng))
+        Some(aimed_across(direction, self.map.eval(towards) / pdf, plane, aim, u[1]))
     }
 
     /// What the map sends into the scene's box: Σ_k F_k ∫ L |ω_k| dω.

@@ -155,6 +155,16 @@ pub trait Source {
     /// A photon's start aimed as `aim` says (its random numbers from `rng`).
     fn sample_le_towards(&self, aim: &impl Aim, rng: &mut Rng) -> Option<Aimed>;
 
+    /// As [`Self::sample_le_towards`], with two uniform points `u` of the
+    /// caustic pass's low-discrepancy sequence ([`crate::sampling::photon_points`])
+    /// for the light to spend where they stratify its caustic: light from
+    /// infinity draws its direction from the first and its start on the
+    /// aimed disk from the second. The other lights keep to `rng` (their
+    /// photons, and the default room's image, as before).
+    fn sample_le_towards_at(&self, aim: &impl Aim, _u: [Vec2; 2], rng: &mut Rng) -> Option<Aimed> {
+        self.sample_le_towards(aim, rng)
+    }
+
     /// Total emitted power per channel.
     fn power(&self) -> Color;
 
@@ -313,6 +323,12 @@ impl Light {
         each!(self, l => l.sample_le_towards(aim, rng))
     }
 
+    /// See [`Source::sample_le_towards_at`].
+    #[inline]
+    pub fn sample_le_towards_at(&self, aim: &impl Aim, u: [Vec2; 2], rng: &mut Rng) -> Option<Aimed> {
+        each!(self, l => l.sample_le_towards_at(aim, u, rng))
+    }
+
     /// See [`Source::power`].
     pub fn power(&self) -> Color {
         each!(self, l => l.power())
@@ -403,8 +419,8 @@ fn aimed_from(
 /// A photon of parallel light along `direction`, of `irradiance` across
 /// it, from the plane through `plane`, started where `aim` says.
 #[inline]
-fn aimed_across(direction: Vec3, irradiance: Color, plane: Vertex, aim: &impl Aim, rng: &mut Rng) -> Aimed {
-    let (origin, pdf) = aim.origin_across(direction, plane, next_2d(rng));
+fn aimed_across(direction: Vec3, irradiance: Color, plane: Vertex, aim: &impl Aim, u: Vec2) -> Aimed {
+    let (origin, pdf) = aim.origin_across(direction, plane, u);
     Aimed { ray: Ray::new(origin, direction), departure: None, intensity: irradiance, pdf }
 }
 

@@ -62,9 +62,16 @@ impl Source for Constant {
     /// irradiance L 4π along it.
     #[inline]
     fn sample_le_towards(&self, aim: &impl Aim, rng: &mut Rng) -> Option<Aimed> {
-        let direction = uniform_cone(next_2d(rng), -1.0).normalize();
+        let u = [next_2d(rng), next_2d(rng)];
+        self.sample_le_towards_at(aim, u, rng)
+    }
+
+    /// The direction from `u[0]`, the start on the aimed disk from `u[1]`.
+    #[inline]
+    fn sample_le_towards_at(&self, aim: &impl Aim, u: [Vec2; 2], _rng: &mut Rng) -> Option<Aimed> {
+        let direction = uniform_cone(u[0], -1.0).normalize();
         let plane = self.reach.upstream(direction);
-        Some(aimed_across(direction, self.radiance * (4.0 * PI), plane, aim, rng))
+        Some(aimed_across(direction, self.radiance * (4.0 * PI), plane, aim, u[1]))
     }
 
     /// Into the scene's box from every direction: ∫ L A(ω) dω = L 2π Σ F_k

@@ -11,7 +11,7 @@ use super::{Photon, PhotonBlocks};
 use crate::light::Aim;
 use crate::material::{Lobe, Transport};
 use crate::math::{max_component, Color, Frame, Ray};
-use crate::sampling::{concentric_disk, next_2d, stream, uniform_cone, uniform_cone_pdf, Domain, Rng};
+use crate::sampling::{concentric_disk, next_2d, photon_points, stream, uniform_cone, uniform_cone_pdf, Domain, Rng};
 use crate::scene::Scene;
 use crate::shape::Departure;
 use glam::{Vec2, Vec3};
@@ -174,6 +174,21 @@ pub fn emit(
     n: u64,
     rng: &mut Rng,
 ) -> (Option<usize>, Option<PhotonStart>) {
+    emit_at(scene, targets, pass, n, None, rng)
+}
+
+/// As [`emit`], a caustic photon taking the light's part of its start from
+/// the points `quasi` where given ([`Source::sample_le_towards_at`]).
+///
+/// [`Source::sample_le_towards_at`]: crate::light::Source::sample_le_towards_at
+pub fn emit_at(
+    scene: &Scene,
+    targets: &[Target],
+    pass: Pass,
+    n: u64,
+    quasi: Option<[Vec2; 2]>,
+    rng: &mut Rng,
+) -> (Option<usize>, Option<PhotonStart>) {
     let Some((light, p_light)) = scene.pick_light(rng.random::<f32>()) else {
         return (None, None);
     };
@@ -191,7 +206,11 @@ pub fn emit(
             let chosen = ((rng.random::<f32>() * targets.len() as f32) as usize).min(targets.len() - 1);
             // The power is what the light sends along the photon divided by
             // the density of the aiming: the mixture over all targets.
-            let aimed = light.sample_le_towards(&Aiming { targets, chosen }, rng);
+            let aim = Aiming { targets, chosen };
+            let aimed = match quasi {
+                Some(u) => light.sample_le_towards_at(&aim, u, rng),
+                None => light.sample_le_towards(&aim, rng),
+            };
             (Some(chosen), aimed.map(|a| (a.ray, a.departure, a.intensity * scale / a.pdf)))
         }
     }
@@ -298,12 +317,17 @@ fn trace_range<const L: usize>(
 ) -> Tally {
     let mut next = range.start;
     let mut tally = Tally { aimed: vec![[0; 2]; targets.len()], ..Default::default() };
+    // Light from infinity takes its caustic photons' starts from a
+    // low-discrepancy sequence (`Source::sample_le_towards_at`); the other
+    // lights draw theirs from the photon's stream.
+    let quasi = matches!(pass, Pass::Caustic) && !scene.lights_at_infinity().is_empty();
     // The next photon of the range that leaves its light.
     let start = |next: &mut u64, tally: &mut Tally| -> Option<Path> {
         while *next < range.end {
             let mut rng = stream(seed, domain, *next);
+            let quasi = quasi.then(|| photon_points(seed, *next));
             *next += 1;
-            let (target, emitted) = emit(scene, targets, pass, n, &mut rng);
+            let (target, emitted) = emit_at(scene, targets, pass, n, quasi, &mut rng);
             if let Some(t) = target {
                 tally.aimed[t][0] += 1;
             }
