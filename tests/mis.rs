@@ -488,3 +488,26 @@ fn rough_glass_splits_agree_in_the_mean_with_less_noise() {
     eprintln!("variance split / chosen: {ratio:.3}");
     assert!(ratio < 0.7, "{ratio}");
 }
+
+/// Where a gather path splits at rough glass and the reflected branch
+/// carries most of the light (the ball's internal reflection near the
+/// critical angle), two paths along it, each about a microfacet normal of
+/// its own and weighed a half, against one: the same mean (the same photon
+/// maps for both), and less noise over the ball (measured: variance x 0.85
+/// over these blocks; x 0.55 with two paths at every split).
+#[test]
+fn two_reflected_paths_agree_in_the_mean_with_less_noise() {
+    let scene = frosted_ball();
+    let settings = Settings { photons: 40_000, caustic_photons: 40_000, gather_rays: 4, ..Settings::default() };
+    let est = Estimates::progressive(&scene, &settings, 0);
+    let maps = photon_pass(&scene, &settings, 0, est, Mode::Quiet, &mut Stats::default());
+    let mut integrator = photon_integrator(&scene, &settings, &maps, est);
+    assert_eq!(integrator.settings.reflected_paths, 2);
+    let two = blocks(&integrator, &scene, 16, 1000, 43);
+    integrator.settings.reflected_paths = 1;
+    let one = blocks(&integrator, &scene, 16, 1000, 44);
+    assert_agree("frosted ball, two reflected paths against one", &two, &one);
+    let ratio = two.var.iter().sum::<f64>() / one.var.iter().sum::<f64>();
+    eprintln!("variance two / one: {ratio:.3}");
+    assert!(ratio < 0.93, "{ratio}");
+}

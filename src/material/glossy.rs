@@ -107,6 +107,15 @@ impl Glossy<'_> {
         }
     }
 
+    /// Rough glass's Fresnel reflectance for `wo` about the surface's own
+    /// normal (zero for any other lobe).
+    pub fn reflectance_about_normal(&self, wo: Vec3, entering: bool) -> f32 {
+        match self {
+            Glossy::Dielectric(d) => crate::optics::fresnel_dielectric(wo.z.abs(), 1.0, d.eta(entering)),
+            _ => 0.0,
+        }
+    }
+
     /// Whether [`Self::sample_split`] splits (rough glass).
     pub fn splits(&self) -> bool {
         matches!(self, Glossy::Dielectric(_))

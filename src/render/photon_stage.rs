@@ -330,6 +330,7 @@ pub fn photon_integrator<'a>(
             defer_reads: true,
             mis: true,
             rough_splits: crate::integrator::photon::ROUGH_SPLITS,
+            reflected_paths: crate::integrator::photon::REFLECTED_PATHS,
         },
     }
 }

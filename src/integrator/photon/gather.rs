@@ -123,7 +123,9 @@ impl<'a> PhotonIntegrator<'a> {
     ///
     /// At its first `splits` rough-glass vertices passed as glossy ones the
     /// path follows both branches about the sampled microfacet normal
-    /// ([`ROUGH_SPLITS`]): the reflected one by a gather of its own.
+    /// ([`ROUGH_SPLITS`]): the reflected one by a gather of its own, by
+    /// [`REFLECTED_PATHS`] of them, each about a normal of its own, where
+    /// it carries most of the light.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn gather(
         &self,
@@ -211,13 +213,27 @@ impl<'a> PhotonIntegrator<'a> {
                     // The reflected branch by a gather of its own, the
                     // refracted one on in this loop.
                     splits -= 1;
-                    if let Some((wi, gw)) = first {
+                    // Further paths along it are drawn as the first (their
+                    // refracted twins unused): the same expectation each.
+                    // Where the reflected branch carries most of the light
+                    // (by the surface's own normal, so the count is the
+                    // same for every normal drawn), more paths along it.
+                    let paths = match g.reflectance_about_normal(wo, entering) >= 0.5 {
+                        true => self.settings.reflected_paths.max(1),
+                        false => 1,
+                    };
+                    for path in 0..paths {
+                        let reflected = match path {
+                            0 => first,
+                            _ => g.sample_split(wo, entering, Transport::Radiance, true, sh.ctx.rng)[0],
+                        };
+                        let Some((wi, gw)) = reflected else { continue };
                         let dir = frame.to_world(wi).normalize();
                         if y.shading_normal == y.normal || y.leaves_as(ray.dir, dir, true) {
                             let pdf = |g: Glossy<'_>| (1.0 - p_specular) * g.pdf(wo, wi, entering);
                             let sample = mis.map(|g| self.bsdf_sample(&y, frame.n, pdf(g)));
                             let (next, next_dep) = y.spawn(dir);
-                            let weight = weight * gw / (1.0 - p_specular);
+                            let weight = weight * gw / ((1.0 - p_specular) * paths as f32);
                             found += weight * self.gather(next, next_dep, Lobe::Glossy, sample, splits, w * weight, sh);
                         }
                     }

@@ -48,6 +48,17 @@ const SPLIT_DEPTH: u32 = 2;
 /// (notes/suite.md, 09-frosted-glass); a split costs one path more, and
 /// two splits at most quadruple the paths of a glossy camera vertex.
 pub const ROUGH_SPLITS: u32 = 2;
+/// Where a gather path splits at rough glass and the reflected branch
+/// carries most of the light (Fresnel's reflectance about the surface's
+/// normal at least a half: inside the glass, near or beyond the critical
+/// angle), that branch is followed by this many paths, each about a
+/// microfacet normal of its own and weighed by their number; the refracted
+/// branch by one. A reflected direction turns by twice the microfacet
+/// normal's tilt, a refracted one by about a third of it (|1 - 1/eta| at
+/// eta 1.5): inside a frosted object the internal reflection is the
+/// branch whose light varies most from sample to sample (notes/method.md,
+/// "Two paths along the reflected branch").
+pub const REFLECTED_PATHS: u32 = 2;
 /// Specular chains are cut after this many bounces (light trapped by total
 /// internal reflection; its share is negligible).
 const MAX_SPECULAR_DEPTH: u32 = 24;
@@ -91,6 +102,11 @@ pub struct PhotonEstimator {
     /// ([`ROUGH_SPLITS`]; 0: never, the estimate it must agree with in
     /// the mean).
     pub rough_splits: u32,
+    /// How many paths follow the reflected branch where a gather path
+    /// splits at rough glass and it carries most of the light
+    /// ([`REFLECTED_PATHS`]; 1: one, the estimate it must agree with in
+    /// the mean).
+    pub reflected_paths: u32,
 }
 
 /// A read of precomputed irradiance that a camera sample leaves for later:
