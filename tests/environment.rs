@@ -195,7 +195,8 @@ fn a_sun_draws_its_share() {
 
 /// A glass ball on a floor under a map with a sun: the caustic photons
 /// start from the pass's Sobol points, keyed by the photon's index as its
-/// random stream is, so the image is the same bits on 1, 2 and 3 threads,
+/// random stream is, so the image is the same bits on 1, 2 and 3 threads
+/// (and a progressive render's, whose passes go on along one sequence),
 /// and another seed makes another image.
 #[test]
 fn an_envmaps_caustic_is_the_same_on_any_number_of_threads() {
@@ -245,4 +246,13 @@ transform = [{ rotate = { axis = [1, 0, 0], degrees = 90 } }]
     assert_eq!(one, render(2, 9));
     assert_eq!(one, render(3, 9));
     assert_ne!(one, render(2, 10));
+    // Progressive passes go on along one sequence: the same too.
+    let passes = |threads: usize, seed: u64| {
+        let s = Settings { caustic_photons: 5_000, seed, ..settings(Method::Photon, 1) };
+        let f = || photonmap::render::render_progressive(&scene, &s, photonmap::render::Budget::passes(3), |_| {}).0;
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(f)
+    };
+    let one = passes(1, 9);
+    assert_eq!(one, passes(2, 9));
+    assert_ne!(one, passes(2, 10));
 }

@@ -62,7 +62,7 @@ struct Tally {
 /// Traces `n` photons of `pass`; `on_block` is told the number of photons
 /// done after each block (for progress bars).
 pub fn trace_pass(scene: &Scene, pass: Pass, n: u64, seed: u64, on_block: &(dyn Fn(u64) + Sync)) -> PassOutput {
-    trace_pass_with(scene, &specular_targets(scene), pass, n, seed, on_block)
+    trace_pass_with(scene, &specular_targets(scene), pass, n, seed, Sequence { seed, first: 0 }, on_block)
 }
 
 /// [`trace_pass`] with the scene's caustic targets found already
@@ -73,6 +73,7 @@ pub fn trace_pass_with(
     pass: Pass,
     n: u64,
     seed: u64,
+    sequence: Sequence,
     on_block: &(dyn Fn(u64) + Sync),
 ) -> PassOutput {
     // Lights that emit nothing emit no photons (choosing among them by power
@@ -106,7 +107,7 @@ pub fn trace_pass_with(
         // are faulted in only as photons are written.
         .map_init(Vec::new, |out: &mut Vec<Photon>, b| {
             let (start, end) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
-            let tally = trace_range::<LANES>(scene, targets, pass, n, seed, domain, start..end, out);
+            let tally = trace_range::<LANES>(scene, targets, pass, n, seed, sequence, domain, start..end, out);
             // Progress in the photons asked for.
             let asked_by = |i: u64| (i as u128 * asked as u128 / n as u128) as u64;
             on_block(asked_by(end) - asked_by(start));
@@ -158,6 +159,17 @@ pub(crate) fn landing_fraction(scene: &Scene, seed: u64) -> f64 {
         })
         .count();
     landed as f64 / PILOT as f64
+}
+
+/// Where a caustic pass's photons lie in its render's low-discrepancy
+/// sequence ([`photon_points`]): the sequence's seed and the index of the
+/// pass's first photon. A progressive render's passes take one sequence
+/// in turn, as a pixel's camera samples do, so that all its photons
+/// together, not only each pass's, are spread evenly.
+#[derive(Clone, Copy, Debug)]
+pub struct Sequence {
+    pub seed: u64,
+    pub first: u64,
 }
 
 /// A photon leaving its light: its ray, the departure and its power.
@@ -311,6 +323,7 @@ fn trace_range<const L: usize>(
     pass: Pass,
     n: u64,
     seed: u64,
+    sequence: Sequence,
     domain: Domain,
     range: std::ops::Range<u64>,
     out: &mut Vec<Photon>,
@@ -325,7 +338,7 @@ fn trace_range<const L: usize>(
     let start = |next: &mut u64, tally: &mut Tally| -> Option<Path> {
         while *next < range.end {
             let mut rng = stream(seed, domain, *next);
-            let quasi = quasi.then(|| photon_points(seed, *next));
+            let quasi = quasi.then(|| photon_points(sequence.seed, sequence.first + *next));
             *next += 1;
             let (target, emitted) = emit_at(scene, targets, pass, n, quasi, &mut rng);
             if let Some(t) = target {
@@ -467,8 +480,28 @@ mod tests {
             let run = |lanes: usize| {
                 let mut out = Vec::new();
                 let counts = match lanes {
-                    1 => trace_range::<1>(&scene, &targets, pass, 8000, 3, domain, 1000..5000, &mut out),
-                    _ => trace_range::<LANES>(&scene, &targets, pass, 8000, 3, domain, 1000..5000, &mut out),
+                    1 => trace_range::<1>(
+                        &scene,
+                        &targets,
+                        pass,
+                        8000,
+                        3,
+                        Sequence { seed: 3, first: 0 },
+                        domain,
+                        1000..5000,
+                        &mut out,
+                    ),
+                    _ => trace_range::<LANES>(
+                        &scene,
+                        &targets,
+                        pass,
+                        8000,
+                        3,
+                        Sequence { seed: 3, first: 0 },
+                        domain,
+                        1000..5000,
+                        &mut out,
+                    ),
                 };
                 let mut bits: Vec<[u32; 7]> = out
                     .iter()

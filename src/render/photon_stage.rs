@@ -13,7 +13,7 @@ use crate::photon::aims::{disk_coverage, needs, specular_targets, Target};
 use crate::photon::irradiance_cache::IrradianceCache;
 use crate::photon::map::PhotonMap;
 use crate::photon::spots::{bright_spots, Spot};
-use crate::photon::trace::{trace_pass_with, Pass};
+use crate::photon::trace::{trace_pass_with, Pass, Sequence};
 use crate::photon::Photon;
 use crate::progress::{Mode, Phase};
 use crate::render::settings::{cache_stride, Settings};
@@ -198,11 +198,17 @@ pub fn photon_pass(
     };
     let t = Instant::now();
     let phase = Phase::start(progress, "photon pass", settings.photons + settings.caustic_photons);
+    // The caustic photons of light at infinity: pass after pass along one
+    // low-discrepancy sequence.
+    let sequence = Sequence { seed: settings.seed, first: pass.wrapping_mul(settings.caustic_photons) };
     // Both passes at once: the threads that finish one pass's last blocks
     // early take the other's instead of waiting.
     let (global, caustic) = rayon::join(
-        || trace_pass_with(scene, &targets, Pass::Global, settings.photons, seed, &|n| phase.advance(n)),
-        || trace_pass_with(scene, &targets, Pass::Caustic, settings.caustic_photons, seed, &|n| phase.advance(n)),
+        || trace_pass_with(scene, &targets, Pass::Global, settings.photons, seed, sequence, &|n| phase.advance(n)),
+        || {
+            let n = settings.caustic_photons;
+            trace_pass_with(scene, &targets, Pass::Caustic, n, seed, sequence, &|n| phase.advance(n))
+        },
     );
     phase.finish();
     stats.photon_time += t.elapsed();
