@@ -13,7 +13,8 @@
 # halves, tools/mitsuba_reference.py --add; the frosted glass's and the
 # gold and glass's were rendered with VARIANT=cuda_ad_rgb on an NVIDIA
 # H100: 1048576 and 2097152 spp, their windows 4194304 and 16777216; the
-# envmap glass's 65536, 16384 extended by 49152 with --add)
+# envmap glass's 65536, 16384 extended by 49152 with --add, its window
+# 4194304 with CROP_SPP=4194304 PASSES=64)
 # Needs Mitsuba 3.9.1 in a Python (MITSUBA_PYTHON, default python3) and, for
 # the llvm variant, DRJIT_LIBLLVM_PATH (see tools/mitsuba_reference.py).
 # Hours of CPU: run it by hand, not in CI.
