@@ -13,8 +13,21 @@
 # halves, tools/mitsuba_reference.py --add; the frosted glass's and the
 # gold and glass's were rendered with VARIANT=cuda_ad_rgb on an NVIDIA
 # H100: 1048576 and 2097152 spp, their windows 4194304 and 16777216; the
-# envmap glass's 65536, 16384 extended by 49152 with --add, its window
-# 4194304 with CROP_SPP=4194304 PASSES=64)
+# envmap glass's window 4194304 with CROP_SPP=4194304 PASSES=64.
+# The envmap glass's whole image (4788224 spp in 2338 passes of 2048) and
+# the volume caustic's (146944 spp, 287 passes of 512; scene 13, exported
+# with the default placement and rendered by volpath, as its XML says)
+# with its cone's window (rows 124-172, columns 92-112: 1769472 spp, 54
+# passes of 32768) were rendered with cuda_ad_rgb on an NVIDIA H200 by
+# tools/mitsuba_passes.py (render OUT cuda_ad_rgb
+# 11:11-envmap-glass.xml:2048:175:20000 13:13-volume-caustic.xml:512:200:30000
+# 13c:13-volume-caustic.xml:32768:60:40000:124,172,92,112, then its exr
+# mode): independent passes, their mean written with the per-pixel
+# variance of the mean from the passes' spread, whose mean square root is
+# the noise their JSON gives. At 65536 spp the envmap glass's noise estimate
+# from two halves (0.0358) was ruled by a few heavy-tailed pixels (the sun
+# through the glass); 2338 passes estimate it steadily (0.0206 at 280576
+# spp falling as 1/sqrt(spp) to 0.0049).)
 # Needs Mitsuba 3.9.1 in a Python (MITSUBA_PYTHON, default python3) and, for
 # the llvm variant, DRJIT_LIBLLVM_PATH (see tools/mitsuba_reference.py).
 # Hours of CPU: run it by hand, not in CI.
