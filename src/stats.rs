@@ -126,6 +126,10 @@ stats! {
     /// probes' spread: render::rims).
     edge_spp: u32 => last,
     edge_spp_max: u32 => last,
+    /// Pixels whose camera samples a pass were raised by the adaptive
+    /// counts (render::adaptive), and the samples added a pass.
+    adaptive_pixels: usize => last,
+    adaptive_samples: u64 => last,
     photon_time: Duration => sum,
     /// The map build: the photon maps (the caustic map's Morton sort and
     /// kd-tree, both maps' grids), then the irradiance cache (estimates at

@@ -58,6 +58,14 @@ impl Summary<'_> {
                 s.edge_pixels, s.edge_spp
             ));
         }
+        if s.adaptive_pixels > 0 {
+            let pixels = st.width as u64 * st.height as u64 * st.spp.max(1) as u64;
+            out.push(format!(
+                "               adaptive: {} pixels took more samples after the first pass ({:+.1}% samples a pass)",
+                s.adaptive_pixels,
+                100.0 * s.adaptive_samples as f64 / pixels.max(1) as f64
+            ));
+        }
         let c = &s.camera;
         if c.rims_too_costly > 0 {
             out.push(

@@ -4,6 +4,7 @@
 //! estimate the emitted part with `edge_spp` samples of their own. Each pixel has its own random
 //! stream per pass, so rows can run on any thread in any order.
 
+use super::adaptive::{allocate, Guide, Samples, PILOT_PASS};
 use super::rims::{light_rims, Rims};
 use crate::camera::Camera;
 use crate::film::Film;
@@ -52,6 +53,10 @@ pub struct Shot {
     /// down) and at most.
     pub edge_spp: u32,
     pub edge_spp_max: u32,
+    /// Pixels given more samples than the pass's by the adaptive counts,
+    /// and the samples added in all.
+    pub adaptive_pixels: usize,
+    pub adaptive_samples: u64,
 }
 
 /// The random-stream index of a pixel in a pass: passes get disjoint streams.
@@ -78,13 +83,29 @@ fn lens_scramble(scramble: u64) -> u64 {
 /// split estimate changes only its noise, not its mean. Found again every
 /// pass, the probes (four camera rays a pixel) were 16-24% of a
 /// progressive pass's camera pass at 1 spp.
-pub fn camera_pass<I: Integrator>(pass: &CameraPass, integrator: &I, progress: Mode, rims: &mut Option<Rims>) -> Shot {
+///
+/// The samples of the pixels' other part follow `guide.samples`
+/// ([`super::adaptive`]): pass 0 always takes `spp` in every pixel; where
+/// the counts are still to be measured it also traces each pixel's pilot
+/// sample and fixes them for the passes after it.
+pub fn camera_pass<I: Integrator>(pass: &CameraPass, integrator: &I, progress: Mode, guide: &mut Guide) -> Shot {
     let camera = &pass.camera;
     let (w, h) = (camera.width, camera.height);
     let spp = pass.spp.max(1);
     let lens = camera.projection.has_lens();
     let mut counters = Counters::default();
-    let rims = rims.get_or_insert_with(|| {
+    let pilot = pass.pass == 0 && guide.needs_pilot();
+    let counts = match (&guide.samples, pass.pass) {
+        (Samples::Fixed(n), 1..) if n.len() == w as usize * h as usize => Some(n.clone()),
+        _ => None,
+    };
+    let (adaptive_pixels, adaptive_samples) = counts.as_ref().map_or((0, 0), |n| {
+        let more = n.iter().filter(|&&k| k > spp).count();
+        (more, n.iter().map(|&k| k.saturating_sub(spp) as u64).sum())
+    });
+    // The pilot's squared difference and rays cast, per pixel.
+    let mut diffs = vec![[0.0f32; 2]; w as usize * h as usize];
+    let rims = guide.rims.get_or_insert_with(|| {
         if pass.edge_spp > 0 {
             light_rims(camera, integrator, pass.seed, &mut counters)
         } else {
@@ -101,22 +122,30 @@ pub fn camera_pass<I: Integrator>(pass: &CameraPass, integrator: &I, progress: M
     let per_row: Vec<Counters> = film
         .pixels
         .par_chunks_mut(w as usize)
+        .zip(diffs.par_chunks_mut(w as usize))
         .enumerate()
-        .map_init(I::Thread::default, |thread, (row, out)| {
+        .map_init(I::Thread::default, |thread, (row, (out, diffs))| {
             let row = row as u32;
             let mut counters = Counters::default();
             if crate::interrupt::requested() {
                 // The pass is abandoned: its rows need not be finished.
                 return counters;
             }
-            for (col, out) in (0..w).zip(out) {
+            for ((col, out), diff) in (0..w).zip(out).zip(diffs) {
                 let pixel = row as u64 * w as u64 + col as u64;
                 let mut rng = stream(pass.seed, Domain::Camera, sample_index(pass.pass, pixel));
                 let mut state = I::Pixel::default();
-                let mut estimate = |part: Part, n: u32| {
+                // The pixel's samples of its other part, and where in its
+                // sequence they start: after pass 0's `spp`, `n` a pass
+                // (`spp` · pass where the counts are even).
+                let n = counts.as_ref().map_or(spp, |c| c[pixel as usize]);
+                let first = match pass.pass {
+                    0 => 0,
+                    p => (spp as u64).wrapping_add((p - 1).wrapping_mul(n as u64)),
+                };
+                let mut estimate = |part: Part, n: u32, first: u64| {
                     let mut ctx = Context { rng: &mut rng, counters: &mut counters, pixel };
                     let scramble = pixel_scramble(pass.seed, pixel, part);
-                    let first = pass.pass.wrapping_mul(n as u64);
                     let mut sum = DVec3::ZERO;
                     for s in 0..n {
                         let index = first.wrapping_add(s as u64) as u32;
@@ -142,12 +171,31 @@ pub fn camera_pass<I: Integrator>(pass: &CameraPass, integrator: &I, progress: M
                     sum += integrator.finish(&mut ctx, thread, &mut state).as_dvec3();
                     sum / n as f64
                 };
-                let value = if rim_spp[pixel as usize] > 0 {
-                    estimate(Part::Reflected, spp) + estimate(Part::Emitted, rim_spp[pixel as usize])
-                } else {
-                    estimate(Part::All, spp)
+                let rim = rim_spp[pixel as usize];
+                let part = if rim > 0 { Part::Reflected } else { Part::All };
+                let other = estimate(part, n, first);
+                let value = match rim {
+                    0 => other,
+                    _ => other + estimate(Part::Emitted, rim, pass.pass.wrapping_mul(rim as u64)),
                 };
                 *out = value.as_vec3();
+                if pilot {
+                    // One sample more of the same part, from a stream of
+                    // its own (pass 0's image is as it was without it).
+                    let mut rng = stream(pass.seed, Domain::Camera, sample_index(PILOT_PASS, pixel));
+                    let u = next_2d(&mut rng);
+                    let on_lens = if lens { next_2d(&mut rng) } else { Vec2::ZERO };
+                    let ray = camera.sample_ray(col, row, u, on_lens);
+                    let mut state = I::Pixel::default();
+                    let before = counters.rays;
+                    let mut ctx = Context { rng: &mut rng, counters: &mut counters, pixel };
+                    let b = integrator.radiance(ray, part, &mut ctx, thread, &mut state).as_dvec3()
+                        + integrator.finish(&mut ctx, thread, &mut state).as_dvec3();
+                    let d = other - b;
+                    let d2 = (d * d).element_sum() / 3.0;
+                    let rays = (counters.rays - before) as f32;
+                    *diff = [if d2.is_finite() { d2 as f32 } else { 0.0 }, rays];
+                }
             }
             phase.advance(1);
             counters
@@ -155,5 +203,13 @@ pub fn camera_pass<I: Integrator>(pass: &CameraPass, integrator: &I, progress: M
         .collect();
     phase.finish();
     let counters = per_row.into_iter().fold(counters, Counters::merge);
-    Shot { film, counters, edge_pixels, edge_spp, edge_spp_max }
+    if pilot && !crate::interrupt::requested() {
+        let (diff, rays): (Vec<f32>, Vec<f32>) = diffs.iter().map(|&[d, r]| (d, r)).unzip();
+        let n = allocate(&diff, &rays, w as usize, h as usize, spp);
+        guide.samples = match n.iter().all(|&k| k == spp) {
+            true => Samples::Even,
+            false => Samples::Fixed(std::sync::Arc::new(n)),
+        };
+    }
+    Shot { film, counters, edge_pixels, edge_spp, edge_spp_max, adaptive_pixels, adaptive_samples }
 }

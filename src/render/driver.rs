@@ -16,6 +16,7 @@
 use super::error_estimate::{ErrorEstimate, Prediction};
 use super::method::RenderMethod;
 use super::render_pass;
+use super::Guide;
 use crate::film::accumulation::Accumulation;
 use crate::film::Film;
 use crate::interrupt;
@@ -165,7 +166,7 @@ pub fn drive(
     observers: &mut [&mut dyn Observer],
 ) -> Run {
     if !plan.progressive {
-        let (film, stats) = render_pass(scene, settings, method, plan.first, progress, &mut None);
+        let (film, stats) = render_pass(scene, settings, method, plan.first, progress, &mut Guide::default());
         let stopped = if interrupt::requested() { Stopped::Interrupted } else { Stopped::Passes };
         let (accumulation, error, predictions) = (plan.start, None, Vec::new());
         return Run { accumulation, stats, stopped, error, predictions, single: Some(film) };
@@ -176,7 +177,13 @@ pub fn drive(
     let mut stats = Stats::default();
     let mut pass = first;
     let mut last_pass_time = Duration::ZERO;
-    let mut rims = None;
+    let mut guide = Guide::progressive(settings.adaptive);
+    if guide.needs_pilot() && first > 0 {
+        // The adaptive counts come from pass 0's pilot: a render that
+        // does not start there renders pass 0 for them alone, so that
+        // its passes take the counts of one process rendering them all.
+        render_pass(scene, settings, method, 0, Mode::Quiet, &mut guide);
+    }
     let mut error = None;
     let mut predictions = Vec::new();
     let stopped = loop {
@@ -203,7 +210,7 @@ pub fn drive(
             }
         }
         let t = Instant::now();
-        let (film, pass_stats) = render_pass(scene, settings, method, pass, Mode::Quiet, &mut rims);
+        let (film, pass_stats) = render_pass(scene, settings, method, pass, Mode::Quiet, &mut guide);
         if interrupt::requested() {
             // The pass was cut short: not a pass of the image.
             break Stopped::Interrupted;

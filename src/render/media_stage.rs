@@ -53,7 +53,7 @@ pub fn media_pass(
     media: &Media,
     camera: &CameraPass,
     progress: Mode,
-    rims: &mut Option<super::Rims>,
+    guide: &mut super::Guide,
     stats: &mut Stats,
 ) -> Film {
     let est = Estimates::progressive(scene, settings, camera.pass as u32);
@@ -147,5 +147,5 @@ pub fn media_pass(
         r_max: est.r_global,
         single_samples: SINGLE_SAMPLES,
     };
-    shoot(camera, &integrator, progress, rims, stats)
+    shoot(camera, &integrator, progress, guide, stats)
 }

@@ -108,13 +108,13 @@ pub trait RenderMethod: Sync {
 
     /// Renders pass `camera.pass`: prepares what the pass needs (a photon
     /// stage, or nothing), then runs the camera pass with its integrator
-    /// ([`shoot`]). `rims`: as for [`camera_pass`].
+    /// ([`shoot`]). `guide`: as for [`camera_pass`].
     fn pass(
         &self,
         scene: &Scene,
         camera: &CameraPass,
         progress: Mode,
-        rims: &mut Option<super::Rims>,
+        guide: &mut super::Guide,
         stats: &mut Stats,
     ) -> Film;
 
@@ -139,15 +139,17 @@ pub fn shoot<I: Integrator>(
     camera: &CameraPass,
     integrator: &I,
     progress: Mode,
-    rims: &mut Option<super::Rims>,
+    guide: &mut super::Guide,
     stats: &mut Stats,
 ) -> Film {
     let t = Instant::now();
-    let shot = camera_pass(camera, integrator, progress, rims);
+    let shot = camera_pass(camera, integrator, progress, guide);
     stats.camera_time = t.elapsed();
     stats.camera = shot.counters;
     stats.edge_pixels = shot.edge_pixels;
     stats.edge_spp = shot.edge_spp;
     stats.edge_spp_max = shot.edge_spp_max;
+    stats.adaptive_pixels = shot.adaptive_pixels;
+    stats.adaptive_samples = shot.adaptive_samples;
     shot.film
 }

@@ -4,6 +4,7 @@
 //! render averages passes whose estimates narrow; the driver ([`driver`])
 //! runs either within a budget, reporting each pass to observers.
 
+pub mod adaptive;
 pub mod camera_pass;
 pub mod driver;
 pub mod error_estimate;
@@ -14,6 +15,7 @@ mod rims;
 pub mod settings;
 pub mod tracers;
 
+pub use adaptive::{Guide, Samples};
 pub use camera_pass::{camera_pass, CameraPass, Placement};
 pub use driver::{drive, render_passes, render_progressive, Budget, Observer, PassReport, Plan, Run, Stopped};
 pub use method::{Method, RenderMethod};
@@ -34,22 +36,23 @@ pub fn render(scene: &Scene, settings: &Settings, progress: Mode) -> (Film, Stat
 /// Renders `scene` in one pass of `method` (a unit made otherwise than
 /// from `settings`: the Whitted tracer's depth).
 pub fn render_with(scene: &Scene, settings: &Settings, method: &dyn RenderMethod, progress: Mode) -> (Film, Stats) {
-    render_pass(scene, settings, method, 0, progress, &mut None)
+    render_pass(scene, settings, method, 0, progress, &mut Guide::default())
 }
 
 /// Pass `pass` of a render: its own photons and camera samples, and (for
 /// photon mapping) the estimates of
 /// [`photon_stage::Estimates::progressive`], which for pass 0 are the
-/// classic ones. A one-pass render is pass 0. `rims`: the pixels on the
-/// rim of a light's image, found by the first pass that needs them and
-/// kept for the passes after it (see [`camera_pass`]).
+/// classic ones. A one-pass render is pass 0. `guide`: the pixels on the
+/// rim of a light's image and the camera samples' counts, found by the
+/// first pass that needs them and kept for the passes after it (see
+/// [`camera_pass`]).
 pub(crate) fn render_pass(
     scene: &Scene,
     settings: &Settings,
     method: &dyn RenderMethod,
     pass: u32,
     progress: Mode,
-    rims: &mut Option<Rims>,
+    guide: &mut Guide,
 ) -> (Film, Stats) {
     let mut stats = Stats { passes: 1, ..Stats::default() };
     let camera = CameraPass {
@@ -60,7 +63,7 @@ pub(crate) fn render_pass(
         pass: pass as u64,
         placement: Placement::Sobol,
     };
-    let film = method.pass(scene, &camera, progress, rims, &mut stats);
+    let film = method.pass(scene, &camera, progress, guide, &mut stats);
     (film, stats)
 }
 
@@ -77,16 +80,15 @@ mod tests {
         let scene = Scene::tncg15(Eye::One);
         let settings =
             Settings { photons: 5_000, caustic_photons: 5_000, width: 48, height: 48, spp: 1, ..Settings::default() };
-        let mut rims = None;
+        let mut guide = Guide::default();
         let unit = settings.method.unit(&settings);
-        let pass =
-            |pass, rims: &mut Option<Rims>| render_pass(&scene, &settings, unit.as_ref(), pass, Mode::Quiet, rims);
-        let (_, first) = pass(0, &mut rims);
-        let found = rims.clone().expect("the first pass fills the rims");
+        let pass = |pass, guide: &mut Guide| render_pass(&scene, &settings, unit.as_ref(), pass, Mode::Quiet, guide);
+        let (_, first) = pass(0, &mut guide);
+        let found = guide.rims.clone().expect("the first pass fills the rims");
         assert_eq!(first.edge_pixels, found.count());
         assert!(first.edge_pixels > 0 && first.edge_pixels < 48 * 48 / 4, "{} rim pixels", first.edge_pixels);
-        let (_, second) = pass(1, &mut rims);
-        assert_eq!(rims.as_ref(), Some(&found));
+        let (_, second) = pass(1, &mut guide);
+        assert_eq!(guide.rims.as_ref(), Some(&found));
         assert_eq!(second.edge_pixels, first.edge_pixels);
         // The rims share the pass's other samples (48 x 48 at 1 spp): each
         // takes that share on average, to a sample's rounding.
@@ -95,8 +97,9 @@ mod tests {
         // Every pixel given as a rim takes the split estimate: a primary ray
         // more for its emitted part, one sample, as the rims may take no
         // more samples than the pass's others.
-        let (_, none) = pass(1, &mut Some(Rims::none(48 * 48)));
-        let (_, all) = pass(1, &mut Some(Rims::from_spread(vec![1.0; 48 * 48])));
+        let with = |rims| Guide { rims: Some(rims), ..Guide::default() };
+        let (_, none) = pass(1, &mut with(Rims::none(48 * 48)));
+        let (_, all) = pass(1, &mut with(Rims::from_spread(vec![1.0; 48 * 48])));
         assert_eq!((none.edge_pixels, all.edge_pixels), (0, 48 * 48));
         assert_eq!(all.edge_spp, 1);
         assert!(all.camera.rays >= none.camera.rays + 48 * 48, "{} {}", all.camera.rays, none.camera.rays);
@@ -119,7 +122,7 @@ mod tests {
         let rims = |text: &str| {
             let file = crate::scene::file::parse(text, std::path::Path::new("room.toml")).unwrap();
             let scene = Scene::from_parts(file.parts);
-            let stats = render_pass(&scene, &settings, unit.as_ref(), 0, Mode::Quiet, &mut None).1;
+            let stats = render_pass(&scene, &settings, unit.as_ref(), 0, Mode::Quiet, &mut Guide::default()).1;
             (stats.edge_pixels, stats.camera.rims_too_costly)
         };
         let (plain, mirrored) = (rims(&text), rims(&text.replace(walls, &mirrors)));

@@ -40,19 +40,19 @@ impl RenderMethod for PhotonMapping {
         scene: &Scene,
         camera: &CameraPass,
         progress: Mode,
-        rims: &mut Option<super::Rims>,
+        guide: &mut super::Guide,
         stats: &mut Stats,
     ) -> Film {
         let settings = &self.settings;
         if let Some(media) = scene.media() {
-            return super::media_stage::media_pass(settings, scene, media, camera, progress, rims, stats);
+            return super::media_stage::media_pass(settings, scene, media, camera, progress, guide, stats);
         }
         let est = Estimates::progressive(scene, settings, camera.pass as u32);
         (stats.r_global, stats.r_caustic, stats.k_global, stats.k_caustic) =
             (est.r_global, est.r_caustic, est.k_global, est.k_caustic);
         let maps = photon_pass(scene, settings, camera.pass, est, progress, stats);
         let integrator = photon_integrator(scene, settings, &maps, est);
-        shoot(camera, &integrator, progress, rims, stats)
+        shoot(camera, &integrator, progress, guide, stats)
     }
 
     fn summary(&self, s: &Stats) -> MethodSummary {

@@ -356,9 +356,9 @@ radiance = [2000, 2000, 2000]
         let settings =
             Settings { photons: 2_000, caustic_photons: 2_000, width: 64, height: 64, spp: 1, ..Settings::default() };
         let unit = settings.method.unit(&settings);
-        let mut rims = None;
-        render_pass(&scene, &settings, unit.as_ref(), 0, Mode::Quiet, &mut rims);
-        let rims = rims.expect("the pass finds the rims");
+        let mut guide = crate::render::Guide::default();
+        render_pass(&scene, &settings, unit.as_ref(), 0, Mode::Quiet, &mut guide);
+        let rims = guide.rims.expect("the pass finds the rims");
         let n = rims.samples(settings.edge_spp, 64 * 64);
         // The ball's image: a disk about the centre, 12 pixels in radius
         // (its angular radius asin(1/4) against the half field of 35

@@ -44,6 +44,10 @@ pub struct Settings {
     /// Progressive photon mapping's radius shrinkage (Knaus & Zwicker 2011):
     /// pass i uses r_i^2 = r_1^2 * prod_{k<i} (k + alpha - 1) / k.
     pub alpha: f32,
+    /// Progressive renders: the passes after pass 0 give more camera
+    /// samples to the pixels whose samples disagree in pass 0's pilot
+    /// (render::adaptive). A classic render is one pass and unchanged.
+    pub adaptive: bool,
 }
 
 /// The defaults of every setting (the command lines show and use these).
@@ -67,6 +71,7 @@ pub const DEFAULT: Settings = Settings {
     edge_spp: 256,
     skip: true,
     alpha: 2.0 / 3.0,
+    adaptive: true,
 };
 
 impl Settings {

@@ -26,11 +26,11 @@ impl RenderMethod for PathTracing {
         scene: &Scene,
         camera: &CameraPass,
         progress: Mode,
-        rims: &mut Option<super::Rims>,
+        guide: &mut super::Guide,
         stats: &mut Stats,
     ) -> Film {
         let integrator = PathIntegrator { scene, shadow_rays: self.shadow_rays, skip: self.skip, mis: true };
-        shoot(camera, &integrator, progress, rims, stats)
+        shoot(camera, &integrator, progress, guide, stats)
     }
 }
 
@@ -56,11 +56,11 @@ impl RenderMethod for WhittedTracing {
         scene: &Scene,
         camera: &CameraPass,
         progress: Mode,
-        rims: &mut Option<super::Rims>,
+        guide: &mut super::Guide,
         stats: &mut Stats,
     ) -> Film {
         let camera = CameraPass { placement: Placement::JitteredGrid, edge_spp: 0, ..*camera };
         let integrator = Whitted { scene, max_depth: self.max_depth };
-        shoot(&camera, &integrator, progress, rims, stats)
+        shoot(&camera, &integrator, progress, guide, stats)
     }
 }
