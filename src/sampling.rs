@@ -30,6 +30,7 @@ pub enum Domain {
     CausticPhotons = 0x00CA_05C1,
     EdgeProbes = 0x00ED_6E00,
     CacheDirect = 0x00CA_D1EC,
+    EmissionPilot = 0x00E1_9170,
 }
 
 /// The random stream of work item `index` in `domain` for run `seed`.

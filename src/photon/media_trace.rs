@@ -26,7 +26,8 @@
 //! and blocks are kept in order: the same photons on any number of threads.
 
 use super::aims::Target;
-use super::trace::{emit, landing_fraction, lit_from_outside, Pass, MAX_EXTRA};
+use super::guide::{EmissionGuide, Stored};
+use super::trace::{emit_at, photons_to_emit, Pass};
 use super::volume_map::VolumePhoton;
 use super::Photon;
 use crate::material::{Lobe, Transport};
@@ -77,15 +78,19 @@ pub fn trace_media_pass(
         Pass::Global => Domain::GlobalPhotons,
         Pass::Caustic => Domain::CausticPhotons,
     };
-    // As the pass of a scene without media does: light from outside
-    // emits as many more photons as miss the scene.
+    // As the pass of a scene without media does: light at infinity sends
+    // its photons where the camera sees their light (in media too), and
+    // the pass emits as many as make n count.
+    let guide = match pass {
+        Pass::Global => EmissionGuide::build(scene, true, seed, &|ray, departure, power, rng| {
+            pilot_photon(scene, media, ray, departure, power, rng)
+        }),
+        Pass::Caustic => None,
+    };
     let asked = n;
     let n = match pass {
-        Pass::Global if lit_from_outside(scene) => {
-            let landed = landing_fraction(scene, seed);
-            (n as f64 / landed.max(1.0 / MAX_EXTRA as f64)).ceil() as u64
-        }
-        _ => n,
+        Pass::Global => photons_to_emit(scene, n, guide.as_ref(), seed),
+        Pass::Caustic => n,
     };
     let blocks: Vec<MediaPhotons> = (0..n.div_ceil(BLOCK))
         .into_par_iter()
@@ -93,7 +98,9 @@ pub fn trace_media_pass(
             let mut out = MediaPhotons::default();
             for i in b * BLOCK..((b + 1) * BLOCK).min(n) {
                 let mut rng = stream(seed, domain, i);
-                if let (_, Some((ray, departure, power))) = emit(scene, targets, pass, n, &mut rng) {
+                if let (_, Some((ray, departure, power))) =
+                    emit_at(scene, targets, pass, n, None, guide.as_ref(), &mut rng)
+                {
                     out.rays += trace_photon(scene, media, pass, ray, departure, power, &mut rng, &mut out);
                 }
             }
@@ -110,6 +117,22 @@ pub fn trace_media_pass(
         all.rays += b.rays;
     }
     all
+}
+
+/// Follows one pilot photon of the global pass ([`EmissionGuide`]) as the
+/// pass would, and returns where it stored photons.
+fn pilot_photon(
+    scene: &Scene,
+    media: &Media,
+    ray: Ray,
+    departure: Option<Departure>,
+    power: Color,
+    rng: &mut Rng,
+) -> Stored {
+    let mut out = MediaPhotons::default();
+    trace_photon(scene, media, Pass::Global, ray, departure, power, rng, &mut out);
+    let surface = out.surface.iter().chain(&out.after_diffuse).map(|p| (p.position(), Some(p.surface_normal())));
+    surface.chain(out.volume.iter().map(|p| (p.pos, None))).collect()
 }
 
 /// Follows one photon, storing into `out`; returns the rays it cast.

@@ -15,6 +15,7 @@ pub mod aims;
 mod blocks;
 mod facing;
 mod grid;
+pub mod guide;
 pub mod irradiance_cache;
 mod kdtree;
 pub mod map;

@@ -7,6 +7,7 @@
 //! are identical whatever the number of threads.
 
 use super::aims::{specular_targets, Target};
+use super::guide::{EmissionGuide, Stored};
 use super::{Photon, PhotonBlocks};
 use crate::light::Aim;
 use crate::material::{Lobe, Transport};
@@ -86,17 +87,21 @@ pub fn trace_pass_with(
         Pass::Global => Domain::GlobalPhotons,
         Pass::Caustic => Domain::CausticPhotons,
     };
-    // Asked for n photons, the global pass of a scene lit from outside
-    // emits as many more as miss it (measured by a pilot of first rays),
-    // so that its map holds what n would in a closed scene.
+    // Light at infinity sends the global pass's photons where the camera
+    // sees their light (`guide`), and the pass emits as many as that
+    // makes n count (`photons_to_emit`).
+    let guide = match pass {
+        Pass::Global => EmissionGuide::build(scene, false, seed, &|ray, departure, power, rng| {
+            pilot_photon(scene, ray, departure, power, rng)
+        }),
+        Pass::Caustic => None,
+    };
     let asked = n;
     let n = match pass {
-        Pass::Global if lit_from_outside(scene) => {
-            let landed = landing_fraction(scene, seed);
-            (n as f64 / landed.max(1.0 / MAX_EXTRA as f64)).ceil() as u64
-        }
-        _ => n,
+        Pass::Global => photons_to_emit(scene, n, guide.as_ref(), seed),
+        Pass::Caustic => n,
     };
+    let guide = guide.as_ref();
     let blocks = n.div_ceil(BLOCK);
     let per_block: Vec<(Vec<Photon>, Tally)> = (0..blocks)
         .into_par_iter()
@@ -107,7 +112,7 @@ pub fn trace_pass_with(
         // are faulted in only as photons are written.
         .map_init(Vec::new, |out: &mut Vec<Photon>, b| {
             let (start, end) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
-            let tally = trace_range::<LANES>(scene, targets, pass, n, seed, sequence, domain, start..end, out);
+            let tally = trace_range::<LANES>(scene, targets, pass, n, seed, sequence, guide, domain, start..end, out);
             // Progress in the photons asked for.
             let asked_by = |i: u64| (i as u128 * asked as u128 / n as u128) as u64;
             on_block(asked_by(end) - asked_by(start));
@@ -134,6 +139,41 @@ pub fn trace_pass_with(
 /// At most this many times the photons asked for are emitted where most
 /// miss the scene.
 pub(crate) const MAX_EXTRA: u64 = 16;
+
+/// How many photons a global pass asked for `n` emits. Light from
+/// everywhere (a sky, an environment map) emits n over the share of its
+/// photons whose first ray meets the scene, at most [`MAX_EXTRA`] times n,
+/// so that its map holds what n would in a closed scene. A guide does not
+/// change what the photons cost: it spends the same number of photons
+/// whose light the camera sees as that natural emission would (the share
+/// the pilot found useful, natural against guided), from fewer emitted.
+pub(crate) fn photons_to_emit(scene: &Scene, n: u64, guide: Option<&EmissionGuide>, seed: u64) -> u64 {
+    let natural = match lit_from_outside(scene) {
+        true => (n as f64 / landing_fraction(scene, seed).max(1.0 / MAX_EXTRA as f64)).ceil(),
+        false => n as f64,
+    };
+    let Some(g) = guide else { return natural as u64 };
+    let (useful, guided) = g.useful_shares(|i| scene.light_prob(i));
+    (natural * (useful / guided).min(1.0)).ceil().max(1.0) as u64
+}
+
+/// Follows one pilot photon of the global pass ([`EmissionGuide`]) as the
+/// pass would, and returns where it stored photons.
+fn pilot_photon(scene: &Scene, ray: Ray, departure: Option<Departure>, power: Color, rng: &mut Rng) -> Stored {
+    let mut path = Path {
+        ray,
+        departure,
+        power,
+        rng: rng.clone(),
+        target: NO_TARGET,
+        bounce: 0,
+        specular_bounces: 0,
+        only_specular_so_far: true,
+    };
+    let mut out = Vec::new();
+    while step(scene, Pass::Global, &mut path, &mut out).0 {}
+    out.iter().map(|p| (p.position(), Some(p.surface_normal()))).collect()
+}
 
 /// Photons of the pilot that measures what share of a pass lands.
 const PILOT: u64 = 4096;
@@ -186,11 +226,12 @@ pub fn emit(
     n: u64,
     rng: &mut Rng,
 ) -> (Option<usize>, Option<PhotonStart>) {
-    emit_at(scene, targets, pass, n, None, rng)
+    emit_at(scene, targets, pass, n, None, None, rng)
 }
 
 /// As [`emit`], a caustic photon taking the light's part of its start from
-/// the points `quasi` where given ([`Source::sample_le_towards_at`]).
+/// the points `quasi` where given ([`Source::sample_le_towards_at`]), a
+/// global one from `guide` where it serves the light.
 ///
 /// [`Source::sample_le_towards_at`]: crate::light::Source::sample_le_towards_at
 pub fn emit_at(
@@ -199,17 +240,24 @@ pub fn emit_at(
     pass: Pass,
     n: u64,
     quasi: Option<[Vec2; 2]>,
+    guide: Option<&EmissionGuide>,
     rng: &mut Rng,
 ) -> (Option<usize>, Option<PhotonStart>) {
-    let Some((light, p_light)) = scene.pick_light(rng.random::<f32>()) else {
+    let Some((index, p_light)) = scene.pick_light_index(rng.random::<f32>()) else {
         return (None, None);
     };
+    let light = &scene.lights[index];
     let scale = 1.0 / (p_light * n as f32);
     match pass {
         Pass::Global => {
-            // The light's natural distribution: each photon carries power / n.
-            let e = light.sample_le(next_2d(rng), next_2d(rng));
-            let power = light.power() * scale * e.weight;
+            // The light's natural distribution: each photon carries power /
+            // n; the guide's, that divided by its density relative to it.
+            let (u_pos, u_dir, w) = match guide.and_then(|g| g.sample(index, rng)) {
+                Some(drawn) => drawn,
+                None => (next_2d(rng), next_2d(rng), 1.0),
+            };
+            let e = light.sample_le(u_pos, u_dir);
+            let power = light.power() * scale * e.weight * w;
             // One that carries nothing is not traced (nor stored, where it
             // would count among an estimate's k nearest).
             (None, (max_component(power) > 0.0).then_some((e.ray, e.departure, power)))
@@ -324,6 +372,7 @@ fn trace_range<const L: usize>(
     n: u64,
     seed: u64,
     sequence: Sequence,
+    guide: Option<&EmissionGuide>,
     domain: Domain,
     range: std::ops::Range<u64>,
     out: &mut Vec<Photon>,
@@ -340,7 +389,7 @@ fn trace_range<const L: usize>(
             let mut rng = stream(seed, domain, *next);
             let quasi = quasi.then(|| photon_points(sequence.seed, sequence.first + *next));
             *next += 1;
-            let (target, emitted) = emit_at(scene, targets, pass, n, quasi, &mut rng);
+            let (target, emitted) = emit_at(scene, targets, pass, n, quasi, guide, &mut rng);
             if let Some(t) = target {
                 tally.aimed[t][0] += 1;
             }
@@ -487,6 +536,7 @@ mod tests {
                         8000,
                         3,
                         Sequence { seed: 3, first: 0 },
+                        None,
                         domain,
                         1000..5000,
                         &mut out,
@@ -498,6 +548,7 @@ mod tests {
                         8000,
                         3,
                         Sequence { seed: 3, first: 0 },
+                        None,
                         domain,
                         1000..5000,
                         &mut out,
