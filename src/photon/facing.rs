@@ -40,7 +40,7 @@ struct Class {
 }
 
 /// The facing class of a normal: 2 * axis + (1 if negative).
-fn class_of(m: Vec3) -> usize {
+pub(super) fn class_of(m: Vec3) -> usize {
     let a = m.abs();
     let axis = if a.x >= a.y && a.x >= a.z {
         0

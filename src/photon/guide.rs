@@ -70,17 +70,10 @@ const CLASSES: usize = 7;
 const VOLUME: usize = 6;
 
 /// The class of a surface whose normal, turned towards the viewer or the
-/// arriving photon, is `n`: its dominant axis and sign.
+/// arriving photon, is `n`: its dominant axis and sign, as the photon
+/// maps' trees split them.
 fn surface_class(n: Vec3) -> usize {
-    let a = n.abs();
-    let axis = if a.x >= a.y && a.x >= a.z {
-        0
-    } else if a.y >= a.z {
-        1
-    } else {
-        2
-    };
-    2 * axis + (n[axis] < 0.0) as usize
+    super::facing::class_of(n)
 }
 
 impl Seen {
