@@ -20,7 +20,15 @@ fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
 }
 
 fn small() -> Settings {
-    Settings { photons: 10_000, caustic_photons: 10_000, spp: 1, width: 48, height: 48, ..Settings::default() }
+    Settings {
+        photons: 10_000,
+        caustic_photons: 10_000,
+        spp: 1,
+        width: 48,
+        height: 48,
+        adaptive: true,
+        ..Settings::default()
+    }
 }
 
 /// The glass ball and the caustic take more samples, the same wherever
@@ -75,7 +83,15 @@ fn adaptive_path_tracing_agrees_with_the_reference_within_noise() {
     let reference = reference("default_e1_200.exr");
     let runs: Vec<(f64, f64)> = (0..8)
         .map(|seed| {
-            let s = Settings { method: Method::Path, spp: 1, width: 200, height: 200, seed, ..Settings::default() };
+            let s = Settings {
+                method: Method::Path,
+                spp: 1,
+                width: 200,
+                height: 200,
+                seed,
+                adaptive: true,
+                ..Settings::default()
+            };
             let (film, stats) = render_progressive(&scene, &s, Budget::passes(4), |_| {});
             assert!(stats.adaptive_pixels > 0);
             assert_eq!(stats.camera.nonfinite, 0);

@@ -179,11 +179,11 @@ pub struct RenderArgs {
     /// nothing.
     #[arg(long)]
     no_skip: bool,
-    /// Progressive renders: every pixel the same camera samples in every
-    /// pass (by default the passes after the first give more samples to
-    /// the pixels whose samples disagree in the first pass's pilot).
+    /// Progressive renders: the passes after the first give more camera
+    /// samples to the pixels whose samples disagreed in the first pass's
+    /// pilot (by default every pixel takes the same samples).
     #[arg(long)]
-    no_adaptive: bool,
+    adaptive: bool,
     /// How 8-bit outputs (.png, .ppm) are made from radiance: display (an
     /// exposure from the image, then sRGB), or the course's linear (255.99 /
     /// i_max) and sqrt mappings, or clamp (1.0 is white). EXR is always
@@ -225,7 +225,7 @@ impl RenderArgs {
             cache_stride: self.cache_stride.map(|n| n as usize),
             caustic_reuse: self.caustic_reuse,
             skip: !self.no_skip,
-            adaptive: !self.no_adaptive,
+            adaptive: self.adaptive,
             ..DEFAULT
         };
         Ok(Request {
