@@ -14,7 +14,8 @@
 //!
 //! Options: `--only NAME` (repeatable), `--no-mitsuba`, `--no-progressive`,
 //! `--seconds S` (the progressive budget, default 60), `--out DIR` (where
-//! the notes go; default notes/).
+//! the notes go; default notes/). `--help` prints these; an unknown option
+//! or an `--only` name not in suite.toml is refused before anything runs.
 
 use photonmap::film::{Film, ToneMap};
 use photonmap::metrics::{box_down, diff_rgb8, Comparison};
@@ -31,6 +32,27 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
+
+const USAGE: &str = "usage: cargo run --release --example suite -- [--only NAME]... \
+[--no-mitsuba] [--no-progressive] [--seconds S] [--out DIR]";
+
+/// The first argument that is not one of the options (or lacks its value),
+/// so that a typo, or `--help`, does not start the whole suite.
+fn unknown_option(args: &[String]) -> Option<String> {
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--no-mitsuba" | "--no-progressive" => {}
+            "--only" | "--seconds" | "--out" => {
+                if it.next().is_none() {
+                    return Some(a.clone());
+                }
+            }
+            _ => return Some(a.clone()),
+        }
+    }
+    None
+}
 
 /// One render scored.
 #[derive(Clone)]
@@ -55,6 +77,14 @@ struct Row {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
+    if let Some(bad) = unknown_option(&args[1..]) {
+        if bad == "--help" || bad == "-h" {
+            println!("{USAGE}");
+            return Ok(());
+        }
+        eprintln!("suite: unknown option or missing value: {bad}\n{USAGE}");
+        std::process::exit(2);
+    }
     let flag = |f: &str| args.iter().any(|a| a == f);
     let value = |f: &str| args.windows(2).filter(|w| w[0] == f).map(|w| w[1].clone()).collect::<Vec<_>>();
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -64,6 +94,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mitsuba = (!flag("--no-mitsuba")).then(mitsuba_python).flatten();
     photonmap::scene::procedural::write_suite_meshes(&root.join("scenes/suite/meshes"), true)?;
     let suite = photonmap::suite::load(&root.join("scenes/suite"))?;
+    if let Some(name) = only.iter().find(|n| !suite.iter().any(|s| &s.name == *n)) {
+        let names: Vec<&str> = suite.iter().map(|s| s.name.as_str()).collect();
+        eprintln!("suite: --only {name}: no such scene (scenes/suite/suite.toml has {})", names.join(", "));
+        std::process::exit(2);
+    }
     let work = std::env::temp_dir().join(format!("photonmap-suite-{}", std::process::id()));
     std::fs::create_dir_all(&work)?;
     std::fs::create_dir_all(out_dir.join("suite"))?;
