@@ -80,10 +80,13 @@ impl Integrator for VolPhotonIntegrator<'_> {
     type Pixel = ();
 
     fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context, thread: &mut VolPhotonThread, _: &mut ()) -> Color {
-        if part == Part::Emitted {
-            return emitted_part(self.scene, self.media, ray, ctx);
+        // A whole sample is the two parts apart: the emitted part follows
+        // both branches at glass, where the path follows one.
+        match part {
+            Part::Emitted => emitted_part(self.scene, self.media, ray, ctx),
+            Part::Reflected => self.path(ray, part, ctx, thread),
+            Part::All => emitted_part(self.scene, self.media, ray, ctx) + self.path(ray, Part::Reflected, ctx, thread),
         }
-        self.path(ray, part, ctx, thread)
     }
 }
 
