@@ -31,6 +31,7 @@ pub enum Domain {
     EdgeProbes = 0x00ED_6E00,
     CacheDirect = 0x00CA_D1EC,
     EmissionPilot = 0x00E1_9170,
+    MediumPilot = 0x0011_7CE1,
 }
 
 /// The random stream of work item `index` in `domain` for run `seed`.

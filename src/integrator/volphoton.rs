@@ -30,11 +30,11 @@ use super::volpath::{emitted_part, roulette, sample_li_everywhere, surface_light
 use super::{Context, Integrator, Part};
 use crate::material::Transport;
 use crate::math::{max_component, Color, Ray};
-use crate::medium::{Media, Medium, Steps};
+use crate::medium::{LitGrid, LitSegment, Media, Medium, Steps};
 use crate::photon::irradiance_cache::IrradianceCache;
 use crate::photon::map::{PhotonMap, Scratch};
 use crate::photon::volume_map::VolumeMap;
-use crate::sampling::next_2d;
+use crate::sampling::{next_2d, stream, Domain};
 use crate::scene::Scene;
 use crate::shape::Departure;
 use rand::RngExt;
@@ -68,11 +68,54 @@ pub struct VolPhotonIntegrator<'a> {
     pub single_samples: u32,
 }
 
+/// Cells along the longest side of a medium's grid of where the lights
+/// reach (12-fog-shafts: 0.125 m cells, its window 6 x 5 of them).
+const LIT_CELLS: u32 = 32;
+
+/// Shadow rays per cell of that grid.
+const LIT_POINTS: u32 = 4;
+
 /// A thread's scratch space.
 #[derive(Default)]
 pub struct VolPhotonThread {
     scratch: Scratch,
     steps: Steps,
+    lit: LitSegment,
+}
+
+/// Where the lights reach into medium `m`: over the scene's bounds, each
+/// cell's mean, over `LIT_POINTS` uniform points in it, of the luminance
+/// a shadow ray to a light drawn by power brings (transmittance
+/// included, no phase function). Its streams are keyed by (medium, cell)
+/// alone: the same grid on any thread count and in every pass, a
+/// sampling density only (any grid gives the same expectation).
+fn lit_grid(scene: &Scene, media: &Media, m: u32, counters: &mut crate::stats::Counters) -> LitGrid {
+    let (lo, hi) = scene.bounds();
+    let res = LitGrid::resolution(lo, hi, LIT_CELLS);
+    let cells = (res[0] * res[1] * res[2]) as usize;
+    let light: Vec<f32> = (0..cells)
+        .map(|i| {
+            let mut rng = stream(0, Domain::MediumPilot, (u64::from(m) << 32) | i as u64);
+            let mut ctx = Context { rng: &mut rng, counters: &mut *counters, pixel: 0 };
+            let (corner, size) = LitGrid::cell_box(lo, hi, res, i);
+            let mut sum = 0.0f32;
+            for _ in 0..LIT_POINTS {
+                let u = glam::Vec3::new(ctx.rng.random(), ctx.rng.random(), ctx.rng.random());
+                let p = corner + size * u;
+                let Some((index, chance)) = scene.pick_light_index(ctx.rng.random::<f32>()) else { continue };
+                let Some(inc) = sample_li_everywhere(&scene.lights[index], p, next_2d(ctx.rng)) else { continue };
+                if inc.intensity == Color::ZERO {
+                    continue;
+                }
+                let reach = inc.target.map_or(f32::INFINITY, |y| (y - p).length());
+                let shadow =
+                    transmittance(scene, media, Ray::new(p, inc.dir), None, reach, inc.prim, Some(m), &mut ctx);
+                sum += crate::texture::luminance(inc.intensity * shadow) / chance;
+            }
+            sum / LIT_POINTS as f32
+        })
+        .collect();
+    LitGrid::new(lo, hi, res, &light)
 }
 
 impl Integrator for VolPhotonIntegrator<'_> {
@@ -206,6 +249,8 @@ impl VolPhotonIntegrator<'_> {
         ctx: &mut Context,
         thread: &mut VolPhotonThread,
     ) -> Color {
+        let grid = self.media.lit_grid(m, || lit_grid(self.scene, self.media, m, ctx.counters));
+        let drawable = thread.lit.build(med, grid, ray, t_max);
         let steps = &thread.steps;
         let mut sum = Color::ZERO;
         for map in [self.volume, self.volume_caustic] {
@@ -217,19 +262,20 @@ impl VolPhotonIntegrator<'_> {
             });
         }
         // The samples stratified along the segment (in the distances'
-        // distribution): a shaft of light crossing a small part of it is
-        // met by some of them in every camera ray.
+        // distribution, transmittance times where the lights reach): a
+        // shaft of light crossing a small part of it is met by most of
+        // them in every camera ray.
         let n = self.single_samples.max(1);
         let mut single = Color::ZERO;
-        for i in 0..n {
+        for i in (0..n).filter(|_| drawable) {
             let u = (i as f32 + ctx.rng.random::<f32>()) / n as f32;
-            single += self.single_scattering(med, m, ray, t_max, u, ctx, steps);
+            single += self.single_scattering(med, m, ray, &thread.lit, u, ctx, steps);
         }
         sum + single / n as f32
     }
 
     /// One estimate of the light scattered once along the segment: a
-    /// distance drawn along it (`u`: its place in their distribution), one
+    /// distance drawn from `lit` (`u`: its place in their distribution), one
     /// light drawn by power, a shadow ray.
     #[allow(clippy::too_many_arguments)]
     fn single_scattering(
@@ -237,13 +283,13 @@ impl VolPhotonIntegrator<'_> {
         med: &Medium,
         m: u32,
         ray: &Ray,
-        t_max: f32,
+        lit: &LitSegment,
         u: f32,
         ctx: &mut Context,
         steps: &Steps,
     ) -> Color {
         let channel = ctx.rng.random::<f32>();
-        let Some((t, pdf_t)) = med.sample_along(ray, t_max, glam::Vec2::new(channel, u)) else {
+        let Some((t, pdf_t)) = lit.sample(glam::Vec2::new(channel, u)) else {
             return Color::ZERO;
         };
         let p = ray.at(t);

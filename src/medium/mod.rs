@@ -22,11 +22,13 @@
 //! MIS, as hero-wavelength sampling does; Wilkie et al. 2014), which
 //! keeps every channel unbiased.
 
+mod lit;
 pub mod phase;
 mod segment;
 pub mod vol_file;
 pub mod volume;
 
+pub use lit::{LitGrid, LitSegment};
 pub use phase::Phase;
 pub use segment::Steps;
 pub use vol_file::{VolError, VolGrid};
@@ -361,12 +363,23 @@ pub struct Media {
     /// Per primitive of the scene.
     interfaces: Vec<Option<Interface>>,
     pub camera: Option<u32>,
+    /// Per medium, where the lights reach into it: built by the first
+    /// camera pass that asks (it needs the whole scene's shadow rays),
+    /// kept for the passes after.
+    lit: Vec<std::sync::OnceLock<LitGrid>>,
 }
 
 impl Media {
     /// `interfaces` per primitive of the scene, in its order.
     pub fn new(media: Vec<Medium>, interfaces: Vec<Option<Interface>>, camera: Option<u32>) -> Self {
-        Media { media, interfaces, camera }
+        let lit = media.iter().map(|_| std::sync::OnceLock::new()).collect();
+        Media { media, interfaces, camera, lit }
+    }
+
+    /// Medium `medium`'s grid of where the lights reach, `build` making it
+    /// the first time (once: callers meanwhile wait for it).
+    pub fn lit_grid(&self, medium: u32, build: impl FnOnce() -> LitGrid) -> &LitGrid {
+        self.lit[medium as usize].get_or_init(build)
     }
 
     /// The medium a ray travelling along `dir` is in after crossing (or
