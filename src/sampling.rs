@@ -163,6 +163,15 @@ pub fn stratified_2d(index: u32, n: u32, u: Vec2) -> Vec2 {
 /// point (the sharp edge of a sunlit patch converges as N^-1.5 in
 /// variance, not N^-1).
 pub fn sobol_owen_2d(index: u32, scramble: u64) -> Vec2 {
+    owen_2d(sobol_2d_bits(index), scramble)
+}
+
+/// The bits of point `index` of the unscrambled two-dimensional Sobol
+/// sequence. They are linear in the index's bits: the point of `a ^ b`
+/// is the XOR of the points of `a` and `b`, so the points of a block
+/// `base ^ g` (`g` below the block's aligned size) are the base's bits
+/// XOR small `g`'s, computed once for the block.
+pub fn sobol_2d_bits(index: u32) -> [u32; 2] {
     let x = index.reverse_bits();
     let mut y = 0u32;
     let (mut i, mut v) = (index, 1u32 << 31);
@@ -173,6 +182,12 @@ pub fn sobol_owen_2d(index: u32, scramble: u64) -> Vec2 {
         i >>= 1;
         v ^= v >> 1;
     }
+    [x, y]
+}
+
+/// Sobol bits ([`sobol_2d_bits`]) Owen-scrambled by `scramble`, as a point
+/// of [0,1)^2.
+pub fn owen_2d([x, y]: [u32; 2], scramble: u64) -> Vec2 {
     let unit = |bits: u32| (bits >> 8) as f32 * (1.0 / (1u32 << 24) as f32);
     Vec2::new(unit(owen_scramble(x, scramble as u32)), unit(owen_scramble(y, (scramble >> 32) as u32)))
 }

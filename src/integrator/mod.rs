@@ -69,6 +69,12 @@ pub trait Integrator: Sync {
     fn finish(&self, _ctx: &mut Context, _thread: &mut Self::Thread, _pixel: &mut Self::Pixel) -> Color {
         Color::ZERO
     }
+
+    /// Tells the pixel which of its samples comes next: its place
+    /// `index` in the pixel's sequence over all passes, and the pixel's
+    /// own `scramble` (the same in every pass), for an estimator that
+    /// draws from a sequence continued from pass to pass.
+    fn start_sample(&self, _pixel: &mut Self::Pixel, _index: u64, _scramble: u64) {}
 }
 
 /// What every integrator's sample has: its random stream, the thread's

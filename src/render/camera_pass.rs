@@ -166,6 +166,7 @@ pub fn camera_pass<I: Integrator>(pass: &CameraPass, integrator: &I, progress: M
                             }
                         };
                         let ray = camera.sample_ray(col, row, u, on_lens);
+                        integrator.start_sample(&mut state, first.wrapping_add(s as u64), scramble);
                         sum += integrator.radiance(ray, part, &mut ctx, thread, &mut state).as_dvec3();
                     }
                     sum += integrator.finish(&mut ctx, thread, &mut state).as_dvec3();

@@ -143,6 +143,13 @@ pub struct PhotonPixel {
     /// aimed rays spread over the targets its points see instead of
     /// repeating one (each choice on its own is still uniform).
     aim_pick: Option<f32>,
+    /// The camera sample's place in the pixel's sequence over all passes
+    /// and the pixel's scramble ([`Integrator::start_sample`]), where the
+    /// camera pass gives them: the cosine gather rays of the sample's
+    /// diffuse point are then points of a scrambled Sobol sequence that
+    /// continues from sample to sample and pass to pass
+    /// ([`gather::GatherSequence`]).
+    sequence: Option<(u64, u64)>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -189,6 +196,10 @@ impl<'a> Integrator for PhotonIntegrator<'a> {
 
     /// Finds every read's cell first (each cell's slot was fetched when its
     /// gather ray hit, and this starts fetching the points), then reads.
+    fn start_sample(&self, pixel: &mut PhotonPixel, index: u64, scramble: u64) {
+        pixel.sequence = Some((index, scramble));
+    }
+
     fn finish(&self, ctx: &mut Context, thread: &mut PhotonThread<'a>, _: &mut PhotonPixel) -> Color {
         let pending = &mut thread.pending;
         for p in pending.iter_mut() {
