@@ -69,7 +69,7 @@ impl RenderMethod for PhotonMapping {
                 pct(s.global_specular_hits, s.global_emitted)
             ),
             format!(
-                "  caustic map  {:>11} emitted {:>11} stored; {:.1}% aimed hit mirror/glass",
+                "  caustic map  {:>11} emitted {:>11} stored{last}; {:.1}% aimed hit mirror/glass",
                 s.caustic_emitted,
                 s.caustic_stored,
                 pct(s.caustic_aimed_hits, s.caustic_emitted)
