@@ -182,9 +182,10 @@ impl LitGrid {
     }
 }
 
-/// One camera segment's distance density: transmittance (per channel,
-/// mixed equally, as [`Medium::sample_along`]) times the grid's weight,
-/// normalised; built once, drawn from several times.
+/// One camera segment's distance density: transmittance (each channel's
+/// σ_t drawn with equal chance, the density their mixture: every channel
+/// unbiased, as spectral MIS makes a free flight) times the grid's
+/// weight, normalised; built once, drawn from several times.
 #[derive(Debug, Default)]
 pub struct LitSegment {
     /// (end, weight) from `start`.
