@@ -1,25 +1,21 @@
 //! The memory a render needs at its peak, as `Settings::estimated_peak_bytes`
 //! predicts it (a render that would not fit is refused before it
-//! allocates), against the peak resident size of the `photonmap` program
-//! measured as it renders: Linux's high-water mark of its resident memory
-//! (`VmHWM` in /proc/PID/status), read until it exits.
+//! allocates), against the peak resident size of the `photonmap` program:
+//! the kernel's high-water mark of its resident memory, which `wait4`
+//! returns when it exits (`ru_maxrss`). Polling `/proc/PID/status` while it
+//! ran missed the peak on a loaded machine, where the poller could sleep
+//! past the child's whole map build and exit.
 
 mod common;
 use common::scratch_dir;
 use photonmap::settings::Settings;
+use std::io::Read;
 use std::process::{Command, Stdio};
-use std::time::Duration;
 
-/// The high-water mark of a running process's resident memory, in bytes.
-fn high_water(pid: u32) -> Option<u64> {
-    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    Some(line.split_whitespace().nth(1)?.parse::<u64>().ok()? * 1024)
-}
-
-/// The peak resident size of `photonmap ARGS`: the largest high-water mark
-/// read while it runs (the mark only grows, and the peak, at the map
-/// build, comes well before the camera pass and the output).
+/// The peak resident size of `photonmap ARGS`, in bytes, from the rusage
+/// that reaping it returns.
+#[cfg(target_os = "linux")]
+#[allow(clippy::zombie_processes)] // reaped by wait4, not Child::wait
 fn peak_of(args: &[&str]) -> u64 {
     let mut child = Command::new(env!("CARGO_BIN_EXE_photonmap"))
         .args(args)
@@ -27,23 +23,22 @@ fn peak_of(args: &[&str]) -> u64 {
         .stderr(Stdio::piped())
         .spawn()
         .expect("run photonmap");
-    let mut peak = 0;
-    while child.try_wait().unwrap().is_none() {
-        peak = peak.max(high_water(child.id()).unwrap_or(0));
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    let out = child.wait_with_output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    peak
+    let mut stderr = String::new();
+    child.stderr.take().expect("piped stderr").read_to_string(&mut stderr).unwrap();
+    let (mut status, mut usage) = (0, unsafe { std::mem::zeroed::<libc::rusage>() });
+    // SAFETY: the child is ours and not yet reaped; both pointers are to
+    // live locals of the types wait4 writes.
+    let pid = unsafe { libc::wait4(child.id() as libc::pid_t, &mut status, 0, &mut usage) };
+    assert_eq!(pid, child.id() as libc::pid_t, "wait4: {}", std::io::Error::last_os_error());
+    assert!(libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0, "{stderr}");
+    // Linux gives ru_maxrss in kilobytes.
+    usage.ru_maxrss as u64 * 1024
 }
 
 /// Within 10% at two mixes of global and caustic photons.
+#[cfg(target_os = "linux")]
 #[test]
 fn the_estimate_matches_the_measured_peaks() {
-    if high_water(std::process::id()).is_none() {
-        eprintln!("no /proc/PID/status VmHWM here: nothing to measure");
-        return;
-    }
     let dir = scratch_dir("memory-peaks");
     let out = dir.join("peak.exr");
     let mut said = Vec::new();
