@@ -12,7 +12,10 @@
 # were extended: a second render with other seeds merged with the first's
 # halves, tools/mitsuba_reference.py --add; the frosted glass's and the
 # gold and glass's were rendered with VARIANT=cuda_ad_rgb on an NVIDIA
-# H100: 1048576 and 2097152 spp, their windows 4194304 and 16777216; the
+# H100: 1048576 and 2097152 spp, the first's window 4194304 (the gold and
+# glass's whole image with the default placement, before its placement
+# below was found; its window 16777216 with the placement below on the
+# 2-core VM: CROP_SPP=8388608 PASSES=128, then as many again with --add); the
 # envmap glass's window 4194304 with CROP_SPP=4194304 PASSES=64.
 # The envmap glass's whole image (4788224 spp in 2338 passes of 2048) and
 # the volume caustic's (146944 spp, 287 passes of 512; scene 13, exported
@@ -62,7 +65,7 @@ scenes=(
   "07-million caustic=100:141,94:135"
   "08-hall caustic=96:128,72:128 --origin 20,9.75,1.05 --scale 100"
   "09-frosted-glass caustic=120:142,86:128"
-  "10-gold-glass caustic=121:134,134:152"
+  "10-gold-glass caustic=121:134,134:152 --origin 0.7,0,0.5 --scale 100"
   "11-envmap-glass caustic=114:142,70:102 --origin 0,0.3,0.501 --scale 100"
 )
 for entry in "${scenes[@]}"; do
