@@ -66,6 +66,9 @@ pub struct VolPhotonIntegrator<'a> {
     /// Single-scattering samples per camera segment in a medium,
     /// stratified along it.
     pub single_samples: u32,
+    /// Shadow rays per smooth camera vertex on a surface (`--shadow-rays`),
+    /// their samples of the lights stratified.
+    pub shadow_rays: u32,
 }
 
 /// Cells along the longest side of a medium's grid of where the lights
@@ -181,7 +184,19 @@ impl VolPhotonIntegrator<'_> {
             let (frame, entering) = hit.scattering_frame(ray.dir, &material);
             let wo = frame.to_local(-ray.dir);
             if material.has_smooth_lobes() {
-                let direct = surface_light(scene, media, &hit, &material, &frame, wo, entering, medium, false, ctx);
+                let direct = surface_light(
+                    scene,
+                    media,
+                    &hit,
+                    &material,
+                    &frame,
+                    wo,
+                    entering,
+                    medium,
+                    false,
+                    self.shadow_rays,
+                    ctx,
+                );
                 let mut reflected = ctx.checked(direct, "direct");
                 if material.diffuse_rho().is_some() {
                     let rho = material.diffuse_albedo(wo);
