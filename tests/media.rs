@@ -75,7 +75,8 @@ fn phase_functions_sample_their_density() {
 /// χ²: single scattering's distances drawn by transmittance times a grid
 /// of where the lights reach (`LitSegment`), grey, chromatic and nearly
 /// clear media, a segment ending inside the grid and one reaching to
-/// infinity, follow the density they report (40 bins along the first
+/// infinity, and a heterogeneous medium's box drawn by the segment's
+/// transmittance across it, follow the density they report (40 bins along the first
 /// `span` of the segment and one for the rest; each bin's expected count
 /// is the density integrated by a 4,000-step midpoint rule, the jumps at
 /// the cells' ends within it costing under 10⁻⁴ of a bin).
@@ -89,14 +90,22 @@ fn lit_distances_follow_their_density() {
         (Color::new(0.1, 0.8, 3.0), Vec3::new(2.5, 1.2, 1.9), Vec3::new(-1.0, -0.3, -0.5), 5.0, 5.0),
         (Color::splat(1e-6), Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.3, 0.1, 0.2), 4.0, 4.0),
         (Color::new(0.5, 0.6, 0.7), Vec3::new(0.0, 0.2, 0.5), Vec3::new(0.3, 0.1, 0.2), f32::INFINITY, 12.0),
+        // Heterogeneous (`smoke()`, its box [-1, 1]³): the colour is the
+        // transmittance across the segment, one channel nearly clear.
+        (Color::new(0.3, 0.6, 0.999_99), Vec3::new(-1.5, 0.1, 0.3), Vec3::new(1.0, 0.2, 0.35), 6.0, 6.0),
     ];
     let chi2 = Chi2 { samples: 200_000, tests: cases.len(), ..Chi2::default() };
     let mut failed = Vec::new();
     for (k, &(sigma, o, d, t_max, span)) in cases.iter().enumerate() {
-        let m = Medium::homogeneous(sigma, albedo.clone(), 1.0, Phase::Isotropic).unwrap();
+        let heterogeneous = k == cases.len() - 1;
+        let m = match heterogeneous {
+            true => smoke(),
+            false => Medium::homogeneous(sigma, albedo.clone(), 1.0, Phase::Isotropic).unwrap(),
+        };
         let ray = Ray::new(o, d.normalize());
         let mut seg = LitSegment::default();
-        assert!(seg.build(&m, &grid, &ray, t_max), "case {k}");
+        let across = if heterogeneous { sigma } else { Color::ONE };
+        assert!(seg.build(&m, &grid, &ray, t_max, across), "case {k}");
         let bins = 40;
         let bin = |t: f32| if t >= span { bins } else { ((t / span * bins as f32) as usize).min(bins - 1) };
         let mut observed = vec![0.0f64; bins + 1];
@@ -274,8 +283,7 @@ fn heterogeneous_estimators_are_unbiased_against_quadrature() {
         (Ray::new(Vec3::new(-2.0, -0.37, -0.25), Vec3::X), 1.8),
     ];
     let media = [(smoke(), rays), (puffs(), puffs_rays)];
-    for (k, (m, ray, t_max)) in media.iter().flat_map(|(m, r)| r.iter().map(move |&(ray, t)| (m, ray, t))).enumerate()
-    {
+    for (k, (m, ray, t_max)) in media.iter().flat_map(|(m, r)| r.iter().map(move |&(ray, t)| (m, ray, t))).enumerate() {
         let bins = 4;
         let (exact, scattered) = quadrature(m, &ray, t_max, bins);
         let n = 200_000;

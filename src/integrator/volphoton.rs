@@ -158,7 +158,7 @@ impl VolPhotonIntegrator<'_> {
                 let med = media.get(m);
                 let tr = med.track(&ray, t_surface, &mut thread.steps);
                 if med.scatters() {
-                    let inscattered = self.segment(med, m, &ray, t_surface, ctx, thread);
+                    let inscattered = self.segment(med, m, &ray, t_surface, tr, ctx, thread);
                     radiance += throughput * ctx.checked(inscattered, "medium");
                 }
                 throughput *= tr;
@@ -254,18 +254,21 @@ impl VolPhotonIntegrator<'_> {
     /// Light scattered towards the eye along the camera segment `ray` over
     /// [0, `t_max`] in medium `m` (whose transmittance [`Medium::track`]
     /// left in the thread's steps): single scattering by shadow rays, the
-    /// rest by the volume maps' beam estimates.
+    /// rest by the volume maps' beam estimates. `across`: the
+    /// transmittance over the whole segment.
+    #[allow(clippy::too_many_arguments)]
     fn segment(
         &self,
         med: &Medium,
         m: u32,
         ray: &Ray,
         t_max: f32,
+        across: Color,
         ctx: &mut Context,
         thread: &mut VolPhotonThread,
     ) -> Color {
         let grid = self.media.lit_grid(m, || lit_grid(self.scene, self.media, m, ctx.counters));
-        let drawable = thread.lit.build(med, grid, ray, t_max);
+        let drawable = thread.lit.build(med, grid, ray, t_max, across);
         let steps = &thread.steps;
         let mut sum = Color::ZERO;
         for map in [self.volume, self.volume_caustic] {
