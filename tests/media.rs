@@ -75,7 +75,8 @@ fn phase_functions_sample_their_density() {
 /// χ²: single scattering's distances drawn by transmittance times a grid
 /// of where the lights reach (`LitSegment`), grey, chromatic and nearly
 /// clear media, a segment ending inside the grid and one reaching to
-/// infinity, follow the density they report (40 bins along the first
+/// infinity, and a heterogeneous medium's box drawn by the segment's
+/// transmittance across it, follow the density they report (40 bins along the first
 /// `span` of the segment and one for the rest; each bin's expected count
 /// is the density integrated by a 4,000-step midpoint rule, the jumps at
 /// the cells' ends within it costing under 10⁻⁴ of a bin).
@@ -89,14 +90,22 @@ fn lit_distances_follow_their_density() {
         (Color::new(0.1, 0.8, 3.0), Vec3::new(2.5, 1.2, 1.9), Vec3::new(-1.0, -0.3, -0.5), 5.0, 5.0),
         (Color::splat(1e-6), Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.3, 0.1, 0.2), 4.0, 4.0),
         (Color::new(0.5, 0.6, 0.7), Vec3::new(0.0, 0.2, 0.5), Vec3::new(0.3, 0.1, 0.2), f32::INFINITY, 12.0),
+        // Heterogeneous (`smoke()`, its box [-1, 1]³): the colour is the
+        // transmittance across the segment, one channel nearly clear.
+        (Color::new(0.3, 0.6, 0.999_99), Vec3::new(-1.5, 0.1, 0.3), Vec3::new(1.0, 0.2, 0.35), 6.0, 6.0),
     ];
     let chi2 = Chi2 { samples: 200_000, tests: cases.len(), ..Chi2::default() };
     let mut failed = Vec::new();
     for (k, &(sigma, o, d, t_max, span)) in cases.iter().enumerate() {
-        let m = Medium::homogeneous(sigma, albedo.clone(), 1.0, Phase::Isotropic).unwrap();
+        let heterogeneous = k == cases.len() - 1;
+        let m = match heterogeneous {
+            true => smoke(),
+            false => Medium::homogeneous(sigma, albedo.clone(), 1.0, Phase::Isotropic).unwrap(),
+        };
         let ray = Ray::new(o, d.normalize());
         let mut seg = LitSegment::default();
-        assert!(seg.build(&m, &grid, &ray, t_max), "case {k}");
+        let across = if heterogeneous { sigma } else { Color::ONE };
+        assert!(seg.build(&m, &grid, &ray, t_max, across), "case {k}");
         let bins = 40;
         let bin = |t: f32| if t >= span { bins } else { ((t / span * bins as f32) as usize).min(bins - 1) };
         let mut observed = vec![0.0f64; bins + 1];
@@ -205,6 +214,32 @@ fn smoke() -> Medium {
     Medium::heterogeneous(Volume::Grid(grid), albedo, 2.0, Phase::Isotropic).unwrap()
 }
 
+/// A grid of a few dense puffs in empty space (its coarse cells' local
+/// majorants far below its largest value, many of them zero), rotated by
+/// 30° (so its box is wider than its cube, whose outside reads by
+/// repeating it), looked up at the nearest cell.
+fn puffs() -> Medium {
+    let n = 32u32;
+    let puffs = [(Vec3::new(0.3, 0.4, 0.5), 0.12, 4.0), (Vec3::new(0.7, 0.6, 0.3), 0.08, 9.0)];
+    let mut data = Vec::new();
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let p = (Vec3::new(x as f32, y as f32, z as f32) + 0.5) / n as f32;
+                let v: f32 = puffs.iter().map(|&(c, r, d)| d * (1.0 - p.distance(c) / r).max(0.0)).sum();
+                data.extend_from_slice(&[v, 0.5 * v, 0.3 * v + 0.05]);
+            }
+        }
+    }
+    let vol = Arc::new(VolGrid { res: [n; 3], channels: 3, bbox: ([0.0; 3], [1.0; 3]), data });
+    let to_world = Affine3A::from_rotation_z(30f32.to_radians())
+        * Affine3A::from_translation(Vec3::splat(-1.0))
+        * Affine3A::from_scale(Vec3::new(2.0, 2.0, 1.5));
+    let grid = Grid::new(vol, to_world, false, Filter::Nearest, Wrap::Repeat).unwrap();
+    let albedo = Volume::Constant { value: Color::new(0.9, 0.5, 0.7), to_world: Affine3A::IDENTITY };
+    Medium::heterogeneous(Volume::Grid(grid), albedo, 1.0, Phase::Isotropic).unwrap()
+}
+
 /// exp(-∫ σ_t) along `ray` over [0, t_max] by the midpoint rule in
 /// 200,000 steps, and the scattered light's density over it in `bins`
 /// bins: ∫ σ_s(t) T(t) dt.
@@ -228,19 +263,29 @@ fn quadrature(m: &Medium, ray: &Ray, t_max: f32, bins: usize) -> (glam::DVec3, V
 /// heterogeneous, chromatic grid are unbiased: their means agree with a
 /// fine quadrature of the same lookups within four standard errors, per
 /// channel, for the transmittance, the chance-weighted passing flights
-/// and the scattered weight in each of 4 stretches of the ray.
+/// and the scattered weight in each of 4 stretches of the ray. Both
+/// track against local majorants: a smooth grid's, and puffs in empty
+/// space rotated so that the rays also cross the box outside its cube.
 #[test]
 fn heterogeneous_estimators_are_unbiased_against_quadrature() {
-    let m = smoke();
     let rays = [
         (Ray::new(Vec3::new(-2.0, -0.3, 0.2), Vec3::X), 4.0),
         (Ray::new(Vec3::new(-0.5, -1.5, -0.7), Vec3::new(0.3, 1.0, 0.5).normalize()), 3.0),
         // Ends inside the grid.
         (Ray::new(Vec3::new(0.2, 0.1, -2.0), Vec3::Z), 2.5),
     ];
-    for (k, (ray, t_max)) in rays.into_iter().enumerate() {
+    let puffs_rays = [
+        // Through both puffs (about (-0.25, -0.37, -0.25) and (0.25,
+        // 0.37, -0.55) in the scene).
+        (Ray::new(Vec3::new(-1.03, -1.56, 0.23), Vec3::new(0.52, 0.79, -0.32).normalize()), 3.5),
+        (Ray::new(Vec3::new(0.35, -1.63, -0.35), Vec3::new(-0.05, 1.0, -0.1).normalize()), 3.5),
+        // Across the box's corners outside the cube, ending in a puff.
+        (Ray::new(Vec3::new(-2.0, -0.37, -0.25), Vec3::X), 1.8),
+    ];
+    let media = [(smoke(), rays), (puffs(), puffs_rays)];
+    for (k, (m, ray, t_max)) in media.iter().flat_map(|(m, r)| r.iter().map(move |&(ray, t)| (m, ray, t))).enumerate() {
         let bins = 4;
-        let (exact, scattered) = quadrature(&m, &ray, t_max, bins);
+        let (exact, scattered) = quadrature(m, &ray, t_max, bins);
         let n = 200_000;
         let mut rng = stream(77, Domain::Camera, k as u64);
         let (mut tr, mut tr2) = (glam::DVec3::ZERO, glam::DVec3::ZERO);

@@ -178,7 +178,7 @@ pub(super) fn radiance(pt: &PathIntegrator, media: &Media, ray: Ray, part: Part,
         vertices += 1;
         let smooth = scatter.lobe != Lobe::Specular;
         if material.has_smooth_lobes() && within(vertices + 1) {
-            let direct = surface_light(scene, media, &hit, &material, &frame, wo, entering, medium, true, ctx);
+            let direct = surface_light(scene, media, &hit, &material, &frame, wo, entering, medium, true, 1, ctx);
             radiance += throughput * ctx.checked(direct, "volpath surface light");
         }
         let dir = frame.to_world(scatter.wi).normalize();
@@ -363,9 +363,11 @@ fn medium_light(
     inc.intensity * tr * (f * w / chance)
 }
 
-/// Light reflected at a surface vertex straight from one light drawn by
-/// power, by a shadow ray weighted against the BSDF's density (`mis`;
-/// else counted in full).
+/// Light reflected at a surface vertex straight from the lights: the mean
+/// of `count` shadow rays, each to a light drawn by power, their samples
+/// of the light stratified; each weighted against the BSDF's density
+/// (`mis`, which one shadow ray's weight assumes: `count` 1) or counted
+/// in full.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn surface_light(
     scene: &Scene,
@@ -377,12 +379,41 @@ pub(super) fn surface_light(
     entering: bool,
     medium: Option<u32>,
     mis: bool,
+    count: u32,
+    ctx: &mut Context,
+) -> Color {
+    let count = count.max(1);
+    let mut sum = Color::ZERO;
+    for s in 0..count {
+        sum += surface_light_sample(scene, media, hit, material, frame, wo, entering, medium, mis, (s, count), ctx);
+    }
+    sum / count as f32
+}
+
+/// One shadow ray of [`surface_light`]: its sample of the light in
+/// stratum `stratum.0` of `stratum.1`.
+#[allow(clippy::too_many_arguments)]
+fn surface_light_sample(
+    scene: &Scene,
+    media: &Media,
+    hit: &Hit,
+    material: &Material,
+    frame: &Frame,
+    wo: Vec3,
+    entering: bool,
+    medium: Option<u32>,
+    mis: bool,
+    stratum: (u32, u32),
     ctx: &mut Context,
 ) -> Color {
     let Some((index, chance)) = scene.pick_light_index(ctx.rng.random::<f32>()) else { return Color::ZERO };
     let light = &scene.lights[index];
     let n = frame.n;
-    let Some(inc) = light.sample_li(hit.point, n, next_2d(ctx.rng)) else { return Color::ZERO };
+    let u = match stratum {
+        (_, 1) => next_2d(ctx.rng),
+        (s, count) => crate::sampling::stratified_2d(s, count, next_2d(ctx.rng)),
+    };
+    let Some(inc) = light.sample_li(hit.point, n, u) else { return Color::ZERO };
     let wi = frame.to_local(inc.dir);
     let cos = wi.z;
     // The side of the actual surface the light arrives on must be the

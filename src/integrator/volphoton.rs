@@ -66,6 +66,9 @@ pub struct VolPhotonIntegrator<'a> {
     /// Single-scattering samples per camera segment in a medium,
     /// stratified along it.
     pub single_samples: u32,
+    /// Shadow rays per smooth camera vertex on a surface (`--shadow-rays`),
+    /// their samples of the lights stratified.
+    pub shadow_rays: u32,
 }
 
 /// Cells along the longest side of a medium's grid of where the lights
@@ -155,7 +158,7 @@ impl VolPhotonIntegrator<'_> {
                 let med = media.get(m);
                 let tr = med.track(&ray, t_surface, &mut thread.steps);
                 if med.scatters() {
-                    let inscattered = self.segment(med, m, &ray, t_surface, ctx, thread);
+                    let inscattered = self.segment(med, m, &ray, t_surface, tr, ctx, thread);
                     radiance += throughput * ctx.checked(inscattered, "medium");
                 }
                 throughput *= tr;
@@ -181,7 +184,19 @@ impl VolPhotonIntegrator<'_> {
             let (frame, entering) = hit.scattering_frame(ray.dir, &material);
             let wo = frame.to_local(-ray.dir);
             if material.has_smooth_lobes() {
-                let direct = surface_light(scene, media, &hit, &material, &frame, wo, entering, medium, false, ctx);
+                let direct = surface_light(
+                    scene,
+                    media,
+                    &hit,
+                    &material,
+                    &frame,
+                    wo,
+                    entering,
+                    medium,
+                    false,
+                    self.shadow_rays,
+                    ctx,
+                );
                 let mut reflected = ctx.checked(direct, "direct");
                 if material.diffuse_rho().is_some() {
                     let rho = material.diffuse_albedo(wo);
@@ -239,18 +254,21 @@ impl VolPhotonIntegrator<'_> {
     /// Light scattered towards the eye along the camera segment `ray` over
     /// [0, `t_max`] in medium `m` (whose transmittance [`Medium::track`]
     /// left in the thread's steps): single scattering by shadow rays, the
-    /// rest by the volume maps' beam estimates.
+    /// rest by the volume maps' beam estimates. `across`: the
+    /// transmittance over the whole segment.
+    #[allow(clippy::too_many_arguments)]
     fn segment(
         &self,
         med: &Medium,
         m: u32,
         ray: &Ray,
         t_max: f32,
+        across: Color,
         ctx: &mut Context,
         thread: &mut VolPhotonThread,
     ) -> Color {
         let grid = self.media.lit_grid(m, || lit_grid(self.scene, self.media, m, ctx.counters));
-        let drawable = thread.lit.build(med, grid, ray, t_max);
+        let drawable = thread.lit.build(med, grid, ray, t_max, across);
         let steps = &thread.steps;
         let mut sum = Color::ZERO;
         for map in [self.volume, self.volume_caustic] {

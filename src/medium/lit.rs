@@ -210,15 +210,31 @@ fn chord(sigma: f32, len: f32) -> f32 {
 }
 
 impl LitSegment {
-    /// The density of `ray`'s segment [0, `t_max`] in `medium` (within a
-    /// heterogeneous one's box, by its majorant) with weights from `grid`;
-    /// false where the segment has no density to draw from.
-    pub fn build(&mut self, medium: &Medium, grid: &LitGrid, ray: &Ray, t_max: f32) -> bool {
+    /// The density of `ray`'s segment [0, `t_max`] in `medium` with
+    /// weights from `grid`; false where the segment has no density to
+    /// draw from. Within a heterogeneous medium's box the transmittance is
+    /// drawn as a homogeneous medium's of the same optical depth over the
+    /// box's part of the segment: `across`, the transmittance over the
+    /// whole segment ([`Medium::track`]'s), gives it. (The global
+    /// majorant, which it was, falls far faster than the transmittance
+    /// through thin smoke: most distances landed near where the segment
+    /// enters the box.)
+    pub fn build(
+        &mut self,
+        medium: &Medium,
+        grid: &LitGrid,
+        ray: &Ray,
+        t_max: f32,
+        across: crate::math::Color,
+    ) -> bool {
         let (sigma, t0, t1) = match medium.kind {
             Kind::Homogeneous { sigma_t } => (sigma_t.to_array(), 0.0, t_max),
-            Kind::Heterogeneous { majorant, bbox } => {
+            Kind::Heterogeneous { bbox, .. } => {
                 let Some((t0, t1)) = bbox.clip(ray, t_max) else { return false };
-                ([majorant; 3], t0, t1)
+                // A channel with no extinction at all draws uniformly: a
+                // tiny mean keeps it drawable.
+                let mean = |tr: f32| if tr > 0.0 { (-tr.ln() / (t1 - t0)).max(1e-6) } else { 1e-6 };
+                (across.to_array().map(|tr| if tr > 0.0 && tr.is_finite() { mean(tr) } else { 1e-6 }), t0, t1)
             }
         };
         // (An unbounded segment, a ray leaving the scene in a medium that
@@ -343,7 +359,7 @@ mod tests {
         let ray = Ray::new(Vec3::new(-1.2, 0.0, 0.4), Vec3::new(1.0, 0.25, 0.3).normalize());
         let t_max = 5.0f32;
         let mut seg = LitSegment::default();
-        assert!(seg.build(&m, &g, &ray, t_max));
+        assert!(seg.build(&m, &g, &ray, t_max, crate::math::Color::ONE));
         let f = |t: f32| if (1.0..2.5).contains(&t) || t > 4.0 { 1.0 } else { 0.1 };
         let exact: f64 = {
             let n = 200_000;

@@ -12,9 +12,10 @@
 //! * a **heterogeneous** medium reads σ_t from a volume ([`volume`]: a
 //!   constant or a `.vol` grid, [`vol_file`]) and has density only inside
 //!   that volume's box; distances are sampled by delta tracking and
-//!   transmittance estimated by ratio tracking against the majorant
-//!   `scale` × the volume's largest value (Woodcock et al. 1965; Novák et
-//!   al. 2014), both unbiased.
+//!   transmittance estimated by ratio tracking (Woodcock et al. 1965;
+//!   Novák et al. 2014), both unbiased, against local majorants: a grid's
+//!   coarse cells each bound its own part ([`Majorants`]); a constant
+//!   volume's is `scale` × its value.
 //!
 //! Both scale σ_t by `scale`. Where σ_t differs between channels, a
 //! distance is drawn in one channel chosen in proportion to the path's
@@ -23,12 +24,14 @@
 //! keeps every channel unbiased.
 
 mod lit;
+mod majorant;
 pub mod phase;
 mod segment;
 pub mod vol_file;
 pub mod volume;
 
 pub use lit::{LitGrid, LitSegment};
+pub use majorant::Majorants;
 pub use phase::Phase;
 pub use segment::Steps;
 pub use vol_file::{VolError, VolGrid};
@@ -38,6 +41,7 @@ use crate::math::{Color, Ray};
 use crate::sampling::Rng;
 use glam::Vec3;
 use rand::RngExt;
+use std::ops::ControlFlow;
 
 /// What a ray's flight through a medium ended in.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,6 +76,11 @@ pub struct Medium {
     /// phase function's samples).
     pub sample_emitters: bool,
     kind: Kind,
+    /// A grid's local majorants (`None`: the one majorant holds everywhere).
+    majorants: Option<std::sync::Arc<Majorants>>,
+    /// [`Self::scatters`], found once: a grid's largest value is a pass
+    /// over all its cells, and every flight and camera segment asks.
+    scatters: bool,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -87,6 +96,7 @@ impl Medium {
     /// refused), `albedo` any volume in [0, 1].
     pub fn homogeneous(sigma_t: Color, albedo: Volume, scale: f32, phase: Phase) -> Result<Medium, String> {
         check_coefficients(sigma_t.min_element(), sigma_t.max_element(), scale, &albedo)?;
+        let scatters = scatters(&albedo, sigma_t.max_element(), scale);
         Ok(Medium {
             sigma_t: Volume::Constant { value: sigma_t, to_world: glam::Affine3A::IDENTITY },
             albedo,
@@ -94,14 +104,22 @@ impl Medium {
             phase,
             sample_emitters: true,
             kind: Kind::Homogeneous { sigma_t: sigma_t * scale },
+            majorants: None,
+            scatters,
         })
     }
 
     /// Mitsuba's `heterogeneous`: σ_t read from `sigma_t` inside its box.
     pub fn heterogeneous(sigma_t: Volume, albedo: Volume, scale: f32, phase: Phase) -> Result<Medium, String> {
         check_coefficients(sigma_t.min(), sigma_t.max(), scale, &albedo)?;
-        let kind = Kind::Heterogeneous { majorant: scale * sigma_t.max(), bbox: sigma_t.bbox() };
-        Ok(Medium { sigma_t, albedo, scale, phase, sample_emitters: true, kind })
+        let majorant = scale * sigma_t.max();
+        let kind = Kind::Heterogeneous { majorant, bbox: sigma_t.bbox() };
+        let majorants = match &sigma_t {
+            Volume::Grid(g) => Some(std::sync::Arc::new(Majorants::new(g, scale, majorant))),
+            Volume::Constant { .. } => None,
+        };
+        let scatters = scatters(&albedo, sigma_t.max(), scale);
+        Ok(Medium { sigma_t, albedo, scale, phase, sample_emitters: true, kind, majorants, scatters })
     }
 
     pub fn is_homogeneous(&self) -> bool {
@@ -110,8 +128,9 @@ impl Medium {
 
     /// Whether light can scatter in the medium (some albedo above zero);
     /// a medium that only absorbs is crossed, never scattered in.
+    #[inline]
     pub fn scatters(&self) -> bool {
-        self.albedo.max() > 0.0 && self.sigma_t.max() > 0.0 && self.scale > 0.0
+        self.scatters
     }
 
     /// The scaled extinction and scattering coefficients at `p`.
@@ -172,29 +191,28 @@ impl Medium {
                     return Flight::Passed { weight: Color::ONE };
                 };
                 let mut w = Color::ONE;
-                let mut t = t0;
-                loop {
-                    t -= (1.0 - rng.random::<f32>()).ln() / majorant;
-                    if !(t < t1) {
-                        return Flight::Passed { weight: w };
-                    }
+                let mut end = None;
+                self.tentative_collisions(majorant, ray, t0, t1, rng, |t, mu, rng| {
                     let p = ray.at(t);
                     let sigma_t = self.sigma_t.eval(p) * self.scale;
                     // A real collision with the path-weighted chance of
                     // σ_t / majorant, a null one with the rest; each
                     // weighed so that every channel stays unbiased.
                     let q = channel_weights(throughput * w);
-                    let real = ((q * sigma_t).element_sum() / majorant).clamp(0.0, 1.0);
+                    let real = ((q * sigma_t).element_sum() / mu).clamp(0.0, 1.0);
                     if rng.random::<f32>() < real {
                         let sigma_s = sigma_t * self.albedo.eval(p);
-                        return Flight::Scattered { t, weight: w * sigma_s / (majorant * real) };
+                        end = Some(Flight::Scattered { t, weight: w * sigma_s / (mu * real) });
+                        return ControlFlow::Break(());
                     }
-                    let sigma_n = (Color::splat(majorant) - sigma_t).max(Color::ZERO);
-                    w *= sigma_n / (majorant * (1.0 - real));
+                    let sigma_n = (Color::splat(mu) - sigma_t).max(Color::ZERO);
+                    w *= sigma_n / (mu * (1.0 - real));
                     if w == Color::ZERO {
-                        return Flight::Passed { weight: w };
+                        return ControlFlow::Break(());
                     }
-                }
+                    ControlFlow::Continue(())
+                });
+                end.unwrap_or(Flight::Passed { weight: w })
             }
         }
     }
@@ -277,21 +295,58 @@ impl Medium {
         mut step: impl FnMut(f32, Color),
     ) -> Color {
         let Some((t0, t1)) = bbox.clip(ray, t_max) else { return Color::ONE };
-        if !(majorant > 0.0) {
-            return Color::ONE;
-        }
         let mut tr = Color::ONE;
-        let mut t = t0;
-        loop {
-            t -= (1.0 - rng.random::<f32>()).ln() / majorant;
-            if !(t < t1) {
-                return tr;
-            }
+        self.tentative_collisions(majorant, ray, t0, t1, rng, |t, mu, _| {
             let sigma_t = self.sigma_t.eval(ray.at(t)) * self.scale;
-            tr *= (Color::ONE - sigma_t / majorant).max(Color::ZERO);
+            tr *= (Color::ONE - sigma_t / mu).max(Color::ZERO);
             step(t, tr);
             if tr == Color::ZERO {
-                return tr;
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        });
+        tr
+    }
+
+    /// The tentative collisions of delta and ratio tracking along `ray`
+    /// over [`t0`, `t1`] (inside a heterogeneous medium's box), in order:
+    /// a Poisson process of the local majorant's rate, told to `collide`
+    /// with that rate until it breaks. One exponential optical depth is
+    /// drawn per collision and spent across the majorants' pieces (the
+    /// process is memoryless), so a piece without a collision costs no
+    /// draw.
+    #[inline]
+    fn tentative_collisions(
+        &self,
+        majorant: f32,
+        ray: &Ray,
+        t0: f32,
+        t1: f32,
+        rng: &mut Rng,
+        mut collide: impl FnMut(f32, f32, &mut Rng) -> ControlFlow<()>,
+    ) {
+        let mut depth = -(1.0 - rng.random::<f32>()).ln();
+        let mut piece = |a: f32, b: f32, mu: f32| {
+            if !(mu > 0.0) {
+                return ControlFlow::Continue(());
+            }
+            let mut t = a;
+            loop {
+                let span = (b - t) * mu;
+                if !(depth < span) {
+                    depth -= span;
+                    return ControlFlow::Continue(());
+                }
+                t += depth / mu;
+                collide(t, mu, rng)?;
+                depth = -(1.0 - rng.random::<f32>()).ln();
+            }
+        };
+        match &self.majorants {
+            Some(m) => m.walk(ray, t0, t1, piece),
+            None => {
+                let _ = piece(t0, t1, majorant);
             }
         }
     }
@@ -316,6 +371,10 @@ fn channel_weights(throughput: Color) -> Color {
     } else {
         Color::splat(1.0 / 3.0)
     }
+}
+
+fn scatters(albedo: &Volume, sigma_t_max: f32, scale: f32) -> bool {
+    albedo.max() > 0.0 && sigma_t_max > 0.0 && scale > 0.0
 }
 
 fn check_coefficients(lo: f32, hi: f32, scale: f32, albedo: &Volume) -> Result<(), String> {

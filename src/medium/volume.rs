@@ -195,6 +195,27 @@ impl Grid {
         }
     }
 
+    /// World to the grid's unit cube.
+    #[inline]
+    pub(super) fn to_local(&self) -> &Affine3A {
+        &self.to_local
+    }
+
+    /// The largest value, over channels, of the cells `lo` to `hi`
+    /// (inclusive, per axis) read by the wrap mode: indices outside the
+    /// grid name the cells a lookup there reads.
+    pub(super) fn block_max(&self, lo: [i32; 3], hi: [i32; 3]) -> f32 {
+        let mut m = 0.0f32;
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    m = m.max(self.cell(x, y, z).max_element());
+                }
+            }
+        }
+        m
+    }
+
     /// The eight cells from `c` to `c` + (1, 1, 1), x fastest.
     #[inline]
     fn corners(&self, c: Vec3) -> [Color; 8] {

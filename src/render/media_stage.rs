@@ -146,6 +146,7 @@ pub fn media_pass(
         k: est.k_global,
         r_max: est.r_global,
         single_samples: SINGLE_SAMPLES,
+        shadow_rays: settings.shadow_rays,
     };
     shoot(camera, &integrator, progress, guide, stats)
 }
