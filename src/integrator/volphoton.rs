@@ -33,6 +33,7 @@ use crate::math::{max_component, Color, Ray};
 use crate::medium::{LitGrid, LitSegment, Media, Medium, Steps};
 use crate::photon::irradiance_cache::IrradianceCache;
 use crate::photon::map::{PhotonMap, Scratch};
+use crate::photon::volume_grid::VolumeGrid;
 use crate::photon::volume_map::VolumeMap;
 use crate::sampling::{next_2d, stream, Domain};
 use crate::scene::Scene;
@@ -56,8 +57,9 @@ pub struct VolPhotonIntegrator<'a> {
     pub cache: Option<&'a IrradianceCache>,
     /// Gather rays per diffuse camera vertex.
     pub gather_rays: u32,
-    /// Photons scattered in media after a diffuse or medium vertex.
-    pub volume: &'a VolumeMap,
+    /// Photons scattered in media after a diffuse or medium vertex, as a
+    /// grid of the light they scatter.
+    pub volume: &'a VolumeGrid,
     /// Photons scattered in media straight after mirrors and glass.
     pub volume_caustic: &'a VolumeMap,
     /// The surface map's k nearest photons and radius cap.
@@ -239,7 +241,8 @@ impl VolPhotonIntegrator<'_> {
     /// Light scattered towards the eye along the camera segment `ray` over
     /// [0, `t_max`] in medium `m` (whose transmittance [`Medium::track`]
     /// left in the thread's steps): single scattering by shadow rays, the
-    /// rest by the volume maps' beam estimates.
+    /// rest by the volume caustic map's beam estimate and the global volume
+    /// photons' grid.
     fn segment(
         &self,
         med: &Medium,
@@ -253,14 +256,13 @@ impl VolPhotonIntegrator<'_> {
         let drawable = thread.lit.build(med, grid, ray, t_max);
         let steps = &thread.steps;
         let mut sum = Color::ZERO;
-        for map in [self.volume, self.volume_caustic] {
-            map.beam(ray, t_max, |c| {
-                if c.photon.medium == m {
-                    let f = med.phase.eval(c.photon.direction(), -ray.dir);
-                    sum += c.photon.power * (f * c.kernel) * med.transmittance_to(steps, c.t);
-                }
-            });
-        }
+        self.volume_caustic.beam(ray, t_max, |c| {
+            if c.photon.medium == m {
+                let f = med.phase.eval(c.photon.direction(), -ray.dir);
+                sum += c.photon.power * (f * c.kernel) * med.transmittance_to(steps, c.t);
+            }
+        });
+        sum += self.volume.integrate(m, &med.phase, ray, t_max, |t| med.transmittance_to(steps, t));
         // The samples stratified along the segment (in the distances'
         // distribution, transmittance times where the lights reach): a
         // shaft of light crossing a small part of it is met by most of

@@ -28,6 +28,7 @@ use crate::photon::irradiance_cache::IrradianceCache;
 use crate::photon::map::PhotonMap;
 use crate::photon::media_trace::{medium_of, trace_media_pass, MAX_NAMED_MEDIA};
 use crate::photon::trace::Pass;
+use crate::photon::volume_grid::VolumeGrid;
 use crate::photon::volume_map::VolumeMap;
 use crate::photon::Photon;
 use crate::progress::{Mode, Phase};
@@ -101,7 +102,7 @@ pub fn media_pass(
         },
         || {
             rayon::join(
-                || VolumeMap::build(global.volume, VOLUME_K, r_volume, narrow),
+                || VolumeGrid::build(&global.volume, VOLUME_K, r_volume, narrow),
                 || VolumeMap::build(caustic.volume, VOLUME_K, r_volume, narrow),
             )
         },
