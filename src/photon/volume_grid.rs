@@ -167,8 +167,7 @@ impl MediumGrid {
             for yi in 0..ny {
                 for xi in 0..nx {
                     let half = |i: usize, last: usize| if i == 0 || i == last { 0.5 } else { 1.0 };
-                    let inside =
-                        cell_volume * half(xi, nx - 1) * half(yi, ny - 1) * half(zi, n[2] as usize);
+                    let inside = cell_volume * half(xi, nx - 1) * half(yi, ny - 1) * half(zi, n[2] as usize);
                     for s in &mut v[(zi * ny + yi) * nx + xi] {
                         *s /= inside;
                     }
@@ -346,7 +345,13 @@ mod tests {
             let (mut a, mut b) = (0.0f64, 0.0f64);
             for _ in 0..1500 {
                 let (u, v) = (0.1 + 0.8 * rng.random::<f32>(), 0.1 + 0.8 * rng.random::<f32>());
-                let o = if dir == Vec3::Y { Vec3::new(u, 0.0, v) } else if dir == Vec3::X { Vec3::new(0.0, u, v) } else { Vec3::new(1.0, u, v) };
+                let o = if dir == Vec3::Y {
+                    Vec3::new(u, 0.0, v)
+                } else if dir == Vec3::X {
+                    Vec3::new(0.0, u, v)
+                } else {
+                    Vec3::new(1.0, u, v)
+                };
                 let ray = Ray::new(o, dir);
                 a += grid.integrate(0, &phase, &ray, 1.0, |t| Color::splat((-sigma * t).exp())).x as f64;
                 map.beam(&ray, 1.0, |c| {
@@ -359,8 +364,8 @@ mod tests {
         }
     }
 
-    /// The same photons give the same grid in any order of media and
-    /// none reaches a medium it did not scatter in.
+    /// A medium's grid holds only the photons that scattered in it: a
+    /// medium without photons (or past the last) reads nothing.
     #[test]
     fn media_are_kept_apart() {
         let mut photons = uniform(10_000, 12, |_| Vec3::Z);
