@@ -1,6 +1,6 @@
 //! Photon mapping's camera pass in a scene with participating media
 //! (Jensen and Christensen 1998; the beam radiance estimate of Jarosz,
-//! Zwicker and Jensen 2008). A camera path follows mirrors, glass,
+//! Zwicker and Jensen 2008 for volume caustics). A camera path follows mirrors, glass,
 //! index-matched crossings and glossy lobes; each light path reaching the
 //! eye is counted by exactly one estimator (notes/method.md §8):
 //!
@@ -10,7 +10,8 @@
 //! | L V (S\|G)* E                 | single scattering: a distance drawn along   |
 //! |                               | each camera segment, a shadow ray to a light|
 //! | L S+ V (S\|G)* E              | volume caustic map, beam estimate           |
-//! | L …(D\|V)… V (S\|G)* E        | volume map, beam estimate                   |
+//! | L …(D\|V)… V (S\|G)* E        | global volume photons' grid, integrated     |
+//! |                               | along the segment cell by cell              |
 //! | L D (S\|G)* E                 | shadow rays at the diffuse or glossy vertex |
 //! | L …(S\|D\|V)… D (S\|G)* E     | surface map (global and caustic photons),   |
 //! |                               | read directly at the diffuse vertex; with   |
