@@ -1,8 +1,9 @@
 //! Photon mapping's camera pass in a scene with participating media
 //! (Jensen and Christensen 1998; the beam radiance estimate of Jarosz,
-//! Zwicker and Jensen 2008 for volume caustics). A camera path follows mirrors, glass,
-//! index-matched crossings and glossy lobes; each light path reaching the
-//! eye is counted by exactly one estimator (notes/method.md §8):
+//! Zwicker and Jensen 2008 for volume caustics). A camera path follows
+//! mirrors, glass, index-matched crossings and glossy lobes; each light
+//! path reaching the eye is counted by exactly one estimator
+//! (notes/method.md §8):
 //!
 //! | light path                    | estimator                                   |
 //! |-------------------------------|---------------------------------------------|

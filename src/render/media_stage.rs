@@ -1,13 +1,14 @@
 //! Photon mapping's pass in a scene with participating media: the global
 //! and caustic photons traced through the media
 //! ([`crate::photon::media_trace`]), the surface map, the global volume
-//! photons' grid and the volume caustic map built, the camera pass with [`VolPhotonIntegrator`] over them.
-//! In a progressive render the surface map's k and radius cap shrink as
-//! the other maps' do ([`Estimates::progressive`]), and every volume
-//! photon's radius (and the global volume grid's cells) by the same factor: the beam estimate's kernel is a
-//! disk about the ray, whose variance grows as 1 / r² and bias shrinks as
-//! r², as a surface estimate's (Knaus and Zwicker 2011; Jarosz,
-//! Nowrouzezahrai et al. 2011 for beams).
+//! photons' grid and the volume caustic map built, the camera pass with
+//! [`VolPhotonIntegrator`] over them. In a progressive render the surface
+//! map's k and radius cap shrink as the other maps' do
+//! ([`Estimates::progressive`]), and every volume photon's radius (and
+//! the global volume grid's cells) by the same factor: the beam
+//! estimate's kernel is a disk about the ray, whose variance grows as
+//! 1 / r² and bias shrinks as r², as a surface estimate's (Knaus and
+//! Zwicker 2011; Jarosz, Nowrouzezahrai et al. 2011 for beams).
 //!
 //! With final gathering (`--gather-rays` above 0), the surface photons
 //! after a diffuse lobe are left out of the map read at camera vertices
