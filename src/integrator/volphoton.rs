@@ -1,8 +1,9 @@
 //! Photon mapping's camera pass in a scene with participating media
 //! (Jensen and Christensen 1998; the beam radiance estimate of Jarosz,
-//! Zwicker and Jensen 2008). A camera path follows mirrors, glass,
-//! index-matched crossings and glossy lobes; each light path reaching the
-//! eye is counted by exactly one estimator (notes/method.md §8):
+//! Zwicker and Jensen 2008 for volume caustics). A camera path follows
+//! mirrors, glass, index-matched crossings and glossy lobes; each light
+//! path reaching the eye is counted by exactly one estimator
+//! (notes/method.md §8):
 //!
 //! | light path                    | estimator                                   |
 //! |-------------------------------|---------------------------------------------|
@@ -10,7 +11,8 @@
 //! | L V (S\|G)* E                 | single scattering: a distance drawn along   |
 //! |                               | each camera segment, a shadow ray to a light|
 //! | L S+ V (S\|G)* E              | volume caustic map, beam estimate           |
-//! | L …(D\|V)… V (S\|G)* E        | volume map, beam estimate                   |
+//! | L …(D\|V)… V (S\|G)* E        | global volume photons' grid, integrated     |
+//! |                               | along the segment cell by cell              |
 //! | L D (S\|G)* E                 | shadow rays at the diffuse or glossy vertex |
 //! | L …(S\|D\|V)… D (S\|G)* E     | surface map (global and caustic photons),   |
 //! |                               | read directly at the diffuse vertex; with   |
@@ -33,6 +35,7 @@ use crate::math::{max_component, Color, Ray};
 use crate::medium::{LitGrid, LitSegment, Media, Medium, Steps};
 use crate::photon::irradiance_cache::IrradianceCache;
 use crate::photon::map::{PhotonMap, Scratch};
+use crate::photon::volume_grid::VolumeGrid;
 use crate::photon::volume_map::VolumeMap;
 use crate::sampling::{next_2d, stream, Domain};
 use crate::scene::Scene;
@@ -56,8 +59,9 @@ pub struct VolPhotonIntegrator<'a> {
     pub cache: Option<&'a IrradianceCache>,
     /// Gather rays per diffuse camera vertex.
     pub gather_rays: u32,
-    /// Photons scattered in media after a diffuse or medium vertex.
-    pub volume: &'a VolumeMap,
+    /// Photons scattered in media after a diffuse or medium vertex, as a
+    /// grid of the light they scatter.
+    pub volume: &'a VolumeGrid,
     /// Photons scattered in media straight after mirrors and glass.
     pub volume_caustic: &'a VolumeMap,
     /// The surface map's k nearest photons and radius cap.
@@ -254,8 +258,8 @@ impl VolPhotonIntegrator<'_> {
     /// Light scattered towards the eye along the camera segment `ray` over
     /// [0, `t_max`] in medium `m` (whose transmittance [`Medium::track`]
     /// left in the thread's steps): single scattering by shadow rays, the
-    /// rest by the volume maps' beam estimates. `across`: the
-    /// transmittance over the whole segment.
+    /// rest by the volume caustic map's beam estimate and the global volume
+    /// photons' grid. `across`: the transmittance over the whole segment.
     #[allow(clippy::too_many_arguments)]
     fn segment(
         &self,
@@ -271,14 +275,13 @@ impl VolPhotonIntegrator<'_> {
         let drawable = thread.lit.build(med, grid, ray, t_max, across);
         let steps = &thread.steps;
         let mut sum = Color::ZERO;
-        for map in [self.volume, self.volume_caustic] {
-            map.beam(ray, t_max, |c| {
-                if c.photon.medium == m {
-                    let f = med.phase.eval(c.photon.direction(), -ray.dir);
-                    sum += c.photon.power * (f * c.kernel) * med.transmittance_to(steps, c.t);
-                }
-            });
-        }
+        self.volume_caustic.beam(ray, t_max, |c| {
+            if c.photon.medium == m {
+                let f = med.phase.eval(c.photon.direction(), -ray.dir);
+                sum += c.photon.power * (f * c.kernel) * med.transmittance_to(steps, c.t);
+            }
+        });
+        sum += self.volume.integrate(m, &med.phase, ray, t_max, |t| med.transmittance_to(steps, t));
         // The samples stratified along the segment (in the distances'
         // distribution, transmittance times where the lights reach): a
         // shaft of light crossing a small part of it is met by most of

@@ -23,6 +23,7 @@ pub mod media_trace;
 mod morton;
 pub mod spots;
 pub mod trace;
+pub mod volume_grid;
 pub mod volume_map;
 
 pub use blocks::PhotonBlocks;
