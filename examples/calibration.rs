@@ -15,7 +15,9 @@
 use photonmap::film::accumulation::Accumulation;
 use photonmap::render::{render_passes, Budget};
 use photonmap::scene::Scene;
-use photonmap::settings::{progressive_caustics, Settings, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP};
+use photonmap::settings::{
+    default_global_photons, progressive_caustics, Settings, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP,
+};
 use plotters::prelude::*;
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -55,7 +57,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let scene = Scene::from_parts(file.parts);
         let (caustic_photons, k_caustic) = progressive_caustics(scene.media().is_some());
         let settings = Settings {
-            photons: PROGRESSIVE_PHOTONS,
+            photons: default_global_photons(PROGRESSIVE_PHOTONS, scene.media().is_some()),
             caustic_photons,
             k_caustic,
             spp: PROGRESSIVE_SPP,

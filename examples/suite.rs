@@ -24,8 +24,8 @@ use photonmap::progress::Mode;
 use photonmap::render::{render, render_progressive, Budget};
 use photonmap::scene::Scene;
 use photonmap::settings::{
-    progressive_caustics, Settings, PROGRESSIVE_CAUSTIC_PHOTONS, PROGRESSIVE_K_CAUSTIC, PROGRESSIVE_PHOTONS,
-    PROGRESSIVE_SPP,
+    default_global_photons, progressive_caustics, Settings, DEFAULT, PROGRESSIVE_CAUSTIC_PHOTONS,
+    PROGRESSIVE_K_CAUSTIC, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP,
 };
 use photonmap::suite::SuiteScene;
 use std::fmt::Write as _;
@@ -115,8 +115,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let file = photonmap::scene::file::load(&s.scene)?;
         let n = file.rays_per_pixel_edge;
         let scene = Scene::from_parts(file.parts);
-        let settings =
-            Settings { spp: n * n, width: scene.camera.width, height: scene.camera.height, ..Settings::default() };
+        let media = scene.media().is_some();
+        let settings = Settings {
+            photons: default_global_photons(DEFAULT.photons, media),
+            spp: n * n,
+            width: scene.camera.width,
+            height: scene.camera.height,
+            ..Settings::default()
+        };
         let (film, _) = render(&scene, &settings, Mode::Quiet);
         let classic = score(&film, t.elapsed().as_secs_f64(), 1)?;
         write(&work.join(format!("{}.exr", s.name)), &film, ToneMap::Display, 1.0)?;
@@ -130,8 +136,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         } else {
             let t = Instant::now();
             let (caustic_photons, k_caustic) = progressive_caustics(scene.media().is_some());
-            let p =
-                Settings { photons: PROGRESSIVE_PHOTONS, caustic_photons, k_caustic, spp: PROGRESSIVE_SPP, ..settings };
+            let photons = default_global_photons(PROGRESSIVE_PHOTONS, media);
+            let p = Settings { photons, caustic_photons, k_caustic, spp: PROGRESSIVE_SPP, ..settings };
             let load = std::time::Duration::ZERO;
             let (film, stats) = render_progressive(&scene, &p, Budget::seconds(seconds - load.as_secs_f64()), |_| {});
             let scored = score(&film, t.elapsed().as_secs_f64(), stats.passes as u64)?;

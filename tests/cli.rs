@@ -232,8 +232,9 @@ fn export_takes_a_negative_origin() {
 
 /// A progressive render given no photon counts takes four times the
 /// caustic photons at four times the caustic k (the estimates' disks of
-/// 250,000 photons at k = 100); given a count, or a k, it keeps what it
-/// was given (the caustic count following the global one).
+/// 250,000 photons at k = 100), or in a scene with media four times the
+/// global photons; given a count, or a k, it keeps what it was given (the
+/// caustic count following the global one).
 #[test]
 fn progressive_passes_take_more_caustic_photons_where_given_no_counts() {
     const FOG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/suite/12-fog-shafts.toml");
@@ -243,12 +244,18 @@ fn progressive_passes_take_more_caustic_photons_where_given_no_counts() {
         (&["--photons", "2e4"], "20000 global, 20000 caustic", "k_caustic: 100,"),
         (&["--caustic-photons", "3e4"], "250000 global, 30000 caustic", "k_caustic: 100,"),
         (&["--k-caustic", "50"], "250000 global, 1000000 caustic", "k_caustic: 50,"),
-        // A caustic photon in a medium goes on through it: not the cheap part there.
-        (&["--scene", FOG, "--integrator", "photon"], "250000 global, 250000 caustic", "k_caustic: 100,"),
+        // A caustic photon in a medium goes on through it: not the cheap part
+        // there; the global photons, read through the volume grid, are.
+        (&["--scene", FOG, "--integrator", "photon"], "1000000 global, 250000 caustic", "k_caustic: 100,"),
         (
             &["--scene", FOG, "--integrator", "photon", "--k-caustic", "50"],
-            "250000 global, 250000 caustic",
+            "1000000 global, 250000 caustic",
             "k_caustic: 50,",
+        ),
+        (
+            &["--scene", FOG, "--integrator", "photon", "--photons", "2e4"],
+            "20000 global, 20000 caustic",
+            "k_caustic: 100,",
         ),
     ];
     for (i, (given, photons, k)) in cases.iter().enumerate() {

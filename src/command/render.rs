@@ -16,7 +16,9 @@ use crate::output::partial::{read_partial, Manifest, Part, Partial};
 use crate::output::read_exr;
 use crate::progress::Mode;
 use crate::provenance::{settings_key, Provenance};
-use crate::render::settings::{progressive_caustics, Settings, DEFAULT, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP};
+use crate::render::settings::{
+    default_global_photons, progressive_caustics, Settings, DEFAULT, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP,
+};
 use crate::render::{drive, Budget, Method, Observer, Plan, Stopped};
 use crate::scene::Eye;
 use crate::stats::counted;
@@ -146,6 +148,10 @@ pub fn run(req: Request) -> Result<Outcome, Error> {
         false => (req.caustic_photons.unwrap_or(photons), DEFAULT.k_caustic),
     };
     let k_caustic = req.k_caustic.unwrap_or(k_caustic);
+    let photons = match req.photons {
+        Some(given) => given,
+        None => default_global_photons(photons, scene.media().is_some()),
+    };
     let settings = Settings { method, photons, caustic_photons, k_caustic, spp, width, height, ..req.settings };
     if let Some(reference) = &reference {
         reference_fits(reference, width, height)?;

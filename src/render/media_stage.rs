@@ -48,29 +48,6 @@ pub const VOLUME_K: usize = 24;
 /// 8 cost less than the segment's beam estimates.
 pub const SINGLE_SAMPLES: u32 = 8;
 
-/// Global photons a pass emits per photon asked for (`--photons`) where
-/// every scattering medium is homogeneous: the global volume photons are
-/// read through a grid whose cost along a camera segment is the cells it
-/// crosses, not the photons ([`crate::photon::volume_grid`]), so more of
-/// them cost the photon pass, the maps' builds and the irradiance cache,
-/// little of the camera pass. 13-volume-caustic's default command at 4
-/// times 10^6: the cone's window's RMSE 0.0281 against 0.0386, for 1.14
-/// times the CPU time (notes/suite.md). A photon's flight through a
-/// heterogeneous medium is delta tracking's many null collisions
-/// (14-smoke's 10^6 photons took 8.6 s where 13's took 1.0 s): there 4
-/// times the photons bought no less error² x time, and it stays 1.
-pub const GLOBAL_SCALE: u64 = 4;
-
-/// The global photons a pass in `media` emits for `asked`.
-fn global_photons(media: &Media, asked: u64) -> u64 {
-    let cheap = media.media.iter().all(|m| m.is_homogeneous() || !m.scatters());
-    if cheap {
-        asked.saturating_mul(GLOBAL_SCALE)
-    } else {
-        asked
-    }
-}
-
 /// One pass of photon mapping in `scene`, whose media are `media`.
 pub fn media_pass(
     settings: &Settings,
@@ -87,7 +64,7 @@ pub fn media_pass(
     let seed = pass_seed(settings.seed, camera.pass);
     let targets = specular_targets(scene);
     let t = Instant::now();
-    let global_photons = global_photons(media, settings.photons);
+    let global_photons = settings.photons;
     let phase = Phase::start(progress, "photon pass", global_photons + settings.caustic_photons);
     let (global, caustic) = rayon::join(
         || trace_media_pass(scene, media, &targets, Pass::Global, global_photons, seed, &|n| phase.advance(n)),
