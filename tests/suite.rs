@@ -2,8 +2,9 @@
 //! independent reference (tests/data/suite/, Mitsuba 3's path tracer):
 //! the image's mean within 2% and the caustic window's within 5%.
 //!
-//! The renders are CI-sized (200 x 200 at 4 spp, 2e5 + 2e5 photons, 8
-//! gather rays). The bounds are the suite's promise; the seed-to-seed
+//! The renders are CI-sized (200 x 200 at 4 spp, 2e5 + 2e5 photons, the
+//! global ones scaled in a scene with media as the default command's are,
+//! 8 gather rays). The bounds are the suite's promise; the seed-to-seed
 //! spread of these renders that they leave room for is measured in
 //! notes/suite.md ("CI renders"). A failure leaves the render, the
 //! reference and their difference under target/test-artifacts/.
@@ -16,13 +17,13 @@ use photonmap::metrics::compare_images;
 use photonmap::output::write;
 use photonmap::progress::Mode;
 use photonmap::render::render;
-use photonmap::settings::Settings;
+use photonmap::settings::{default_global_photons, Settings};
 use std::path::Path;
 
 fn check(name: &str) {
     let (s, scene, reference) = suite_scene(name);
     let settings = Settings {
-        photons: 200_000,
+        photons: default_global_photons(200_000, scene.media().is_some()),
         caustic_photons: 200_000,
         spp: 4,
         gather_rays: 8,
