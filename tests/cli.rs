@@ -269,3 +269,29 @@ fn progressive_passes_take_more_caustic_photons_where_given_no_counts() {
         assert!(get("settings").unwrap().contains(k), "{given:?}: {:?}", get("settings"));
     }
 }
+
+/// In a scene with participating media the photon camera pass neither aims
+/// gather rays nor reuses caustic estimates: a value set for either is
+/// warned of by name, not silently ignored; left at its default, nothing
+/// is said.
+#[test]
+fn flags_that_media_do_not_use_are_named() {
+    const FOG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/suite/12-fog-shafts.toml");
+    let dir = scratch_dir("cli-media-flags");
+    let exr = dir.join("fog.exr");
+    let base = ["--scene", FOG, "--integrator", "photon", "--photons", "1e3", "--caustic-photons", "1e3"];
+    let small = ["--width", "8", "--height", "8", "--spp", "1", exr.to_str().unwrap()];
+    for (given, warned) in [
+        (&[][..], &[][..]),
+        (&["--aimed-gather-rays", "2"][..], &["--aimed-gather-rays"][..]),
+        (&["--caustic-reuse", "0.3"][..], &["--caustic-reuse"][..]),
+    ] {
+        let o = photonmap(&[&base[..], given, &small[..]].concat());
+        assert!(o.status.success(), "{given:?}: {}", stderr(&o));
+        let said = stderr(&o);
+        for flag in ["--aimed-gather-rays", "--caustic-reuse"] {
+            let line = format!("warning: {flag} has no effect in a scene with participating media");
+            assert_eq!(said.contains(&line), warned.contains(&flag), "{given:?}: {said}");
+        }
+    }
+}

@@ -181,6 +181,18 @@ pub fn run(req: Request) -> Result<Outcome, Error> {
         if settings.caustic_photons == 0 {
             eprintln!("photonmap: warning: no caustic photons: caustics are missing");
         }
+        // Volumetric photon mapping's camera pass gathers without aiming
+        // and reads no reused caustic estimates: say so rather than
+        // ignore a value the user set.
+        if method == Method::Photon && scene.media().is_some() {
+            let set = [
+                ("--aimed-gather-rays", settings.aimed_gather_rays != DEFAULT.aimed_gather_rays),
+                ("--caustic-reuse", settings.caustic_reuse != DEFAULT.caustic_reuse),
+            ];
+            for (flag, _) in set.iter().filter(|(_, given)| *given) {
+                eprintln!("photonmap: warning: {flag} has no effect in a scene with participating media");
+            }
+        }
     }
     let mode = Mode::detect(req.quiet);
     let unit = settings.method.unit(&settings);
