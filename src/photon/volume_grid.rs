@@ -32,7 +32,7 @@ use super::volume_map::VolumePhoton;
 use crate::math::{Color, Ray};
 use crate::medium::{Aabb, Phase};
 use glam::Vec3;
-use std::collections::HashMap;
+use std::collections::HashSet;
 
 /// The most vertices of one medium's grid (24 bytes each: 100 MB); a
 /// denser grid's spacing grows to fit.
@@ -121,10 +121,10 @@ impl MediumGrid {
         let extent = (hi - lo).max(Vec3::splat(1e-4 * (hi - lo).max_element().max(1e-4)));
         // The space the photons occupy: the coarse cells holding any.
         let coarse = (extent.x * extent.y * extent.z * k as f32 / photons.len() as f32).cbrt().max(1e-6);
-        let mut occupied: HashMap<(i32, i32, i32), ()> = HashMap::with_capacity(photons.len() / k.max(1) + 1);
+        let mut occupied: HashSet<(i32, i32, i32)> = HashSet::with_capacity(photons.len() / k.max(1) + 1);
         for p in photons {
             let c = ((p.pos - lo) / coarse).floor();
-            occupied.insert((c.x as i32, c.y as i32, c.z as i32), ());
+            occupied.insert((c.x as i32, c.y as i32, c.z as i32));
         }
         let volume = (occupied.len() as f32 * coarse.powi(3)).min(extent.x * extent.y * extent.z).max(1e-12);
         let density = photons.len() as f32 / volume;
