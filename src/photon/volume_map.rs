@@ -39,6 +39,14 @@ impl VolumePhoton {
     }
 }
 
+/// Grids finer than the first, each half the cell of the one before:
+/// where the photons crowd (a volume caustic's cone, a few tenths of a
+/// metre across in a room), the first grid's 27 cells span more than the
+/// crowd, read a fraction of its density and give its photons spheres
+/// several times too wide, which blurs the crowd's light out of it (a
+/// bias that shrinks only as the radius does).
+const FINER_GRIDS: usize = 4;
+
 /// The squared radius of each photon of `photons` (see [`VolumeMap::build`]).
 fn radii(photons: &[VolumePhoton], k: usize, r_max: f32, shrink: f32) -> Vec<f32> {
     let (lo, hi) =
@@ -46,28 +54,51 @@ fn radii(photons: &[VolumePhoton], k: usize, r_max: f32, shrink: f32) -> Vec<f32
     let extent = (hi - lo).max(Vec3::splat(1e-6 * (hi - lo).max_element().max(1e-6)));
     // Cells of about k photons were the photons spread evenly through
     // their box; no smaller than a tenth of the cap.
-    let cell = ((extent.x * extent.y * extent.z * k as f32 / photons.len() as f32).cbrt()).max(0.1 * r_max);
-    let key = |p: Vec3| {
+    let coarse = ((extent.x * extent.y * extent.z * k as f32 / photons.len() as f32).cbrt()).max(0.1 * r_max);
+    let cells: Vec<f32> = (0..=FINER_GRIDS).map(|l| coarse / (1u32 << l) as f32).collect();
+    let key = |p: Vec3, cell: f32| {
         let c = ((p - lo) / cell).floor();
         (c.x as i32, c.y as i32, c.z as i32)
     };
-    let mut counts: HashMap<(i32, i32, i32), u32> = HashMap::with_capacity(photons.len() / k.max(1) + 1);
-    for p in photons {
-        *counts.entry(key(p.pos)).or_insert(0) += 1;
-    }
+    let grids: Vec<HashMap<(i32, i32, i32), u32>> = cells
+        .par_iter()
+        .map(|&cell| {
+            let mut counts = HashMap::with_capacity(photons.len() / k.max(1) + 1);
+            for p in photons {
+                *counts.entry(key(p.pos, cell)).or_insert(0u32) += 1;
+            }
+            counts
+        })
+        .collect();
+    let block = |p: Vec3, level: usize| {
+        let (x, y, z) = key(p, cells[level]);
+        let mut n = 0u32;
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    n += grids[level].get(&(x + dx, y + dy, z + dz)).copied().unwrap_or(0);
+                }
+            }
+        }
+        n
+    };
     let r2_max = r_max * r_max;
     photons
         .par_iter()
         .map(|p| {
-            let (x, y, z) = key(p.pos);
-            let mut n = 0u32;
-            for dz in -1..=1 {
-                for dy in -1..=1 {
-                    for dx in -1..=1 {
-                        n += counts.get(&(x + dx, y + dy, z + dz)).copied().unwrap_or(0);
-                    }
+            // The finest grid whose 27 cells about the photon still hold k
+            // photons: a block about as wide as the sphere of k photons
+            // there, as a k-nearest search would find it.
+            let mut level = 0;
+            let mut n = block(p.pos, 0);
+            while level < FINER_GRIDS {
+                let finer = block(p.pos, level + 1);
+                if (finer as usize) < k {
+                    break;
                 }
+                (level, n) = (level + 1, finer);
             }
+            let cell = cells[level];
             let density = n as f32 / (27.0 * cell * cell * cell);
             // (4/3) π r³ density = k.
             let r = (3.0 * k as f32 / (4.0 * std::f32::consts::PI * density)).cbrt();
