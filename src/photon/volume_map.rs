@@ -321,6 +321,42 @@ mod tests {
         assert!((mean - 0.6).abs() < 0.03, "{mean}");
     }
 
+    /// Where the photons crowd into a small part of their box (a volume
+    /// caustic's cone in a room), a photon's sphere is about the one a
+    /// k-nearest search gives it: the first grid's cells, sized for the
+    /// photons spread evenly, span the whole crowd and gave these
+    /// photons spheres about six times too wide.
+    #[test]
+    fn crowded_photons_get_the_k_nearest_radius() {
+        let mut rng = stream(13, Domain::Camera, 3);
+        let (k, sparse, crowd) = (24, 2000, 20_000);
+        let room = Vec3::new(4.0, 4.0, 3.0);
+        let mut photons: Vec<VolumePhoton> = (0..sparse)
+            .map(|_| {
+                let p = Vec3::new(rng.random(), rng.random(), rng.random()) * room;
+                VolumePhoton::new(p, Color::ONE, Vec3::Z, 0)
+            })
+            .collect();
+        // A cylinder of radius 0.05 and length 1 along z.
+        photons.extend((0..crowd).map(|_| {
+            let (r, phi) = (0.05 * rng.random::<f32>().sqrt(), std::f32::consts::TAU * rng.random::<f32>());
+            let p = Vec3::new(2.0 + r * phi.cos(), 2.0 + r * phi.sin(), 1.0 + rng.random::<f32>());
+            VolumePhoton::new(p, Color::ONE, Vec3::Z, 0)
+        }));
+        let r2 = radii(&photons, k, 0.5, 1.0);
+        let mut ratios: Vec<f32> = (sparse..sparse + crowd)
+            .step_by(100)
+            .map(|i| {
+                let mut d2: Vec<f32> = photons.iter().map(|q| (q.pos - photons[i].pos).length_squared()).collect();
+                d2.select_nth_unstable_by(k, f32::total_cmp);
+                (r2[i] / d2[k]).sqrt()
+            })
+            .collect();
+        ratios.sort_unstable_by(f32::total_cmp);
+        let median = ratios[ratios.len() / 2];
+        assert!((0.7..1.6).contains(&median), "radius over the k-nearest distance: {median}");
+    }
+
     /// A segment that ends where the medium ends (a wall) reads the
     /// density there without bias: with photons of total power Φ uniform
     /// through a unit cube, segments of length 0.05 that end on its face
