@@ -222,3 +222,29 @@ fn a_guided_pass_is_the_same_on_any_number_of_threads() {
     assert!(one.len() > 100, "{} photons stored", one.len());
     assert_eq!(one, on(3));
 }
+
+/// A guided global pass asked for n emits n (the guide's photons cost what
+/// a closed scene's n do), and most of them reach the room through the
+/// window (the sun's natural emission sends few: the window is a small
+/// part of the disk over the scene).
+#[test]
+fn a_guided_pass_emits_what_is_asked_and_most_reach_the_room() {
+    let scene = room();
+    let n = 20_000;
+    let out = photonmap::photon::trace::trace_pass(&scene, Pass::Global, n, 5, &|_| {});
+    assert_eq!(out.emitted, n);
+    let g = guide(&scene, 5);
+    let (mut guided, mut natural) = (0u32, 0u32);
+    for i in 0..4000 {
+        let mut rng = stream(9, Domain::GlobalPhotons, i);
+        let (_, start) = emit_at(&scene, &[], Pass::Global, n, None, Some(&g), &mut rng);
+        let (ray, _, power) = start.unwrap();
+        guided += (through_window(&ray, power) > 0.0) as u32;
+        let mut rng = stream(9, Domain::GlobalPhotons, i);
+        let (_, start) = emit(&scene, &[], Pass::Global, n, &mut rng);
+        let (ray, _, power) = start.unwrap();
+        natural += (through_window(&ray, power) > 0.0) as u32;
+    }
+    assert!(guided > 2000, "{guided} of 4000 guided photons through the window");
+    assert!(guided > 3 * natural, "{guided} guided against {natural} natural through the window");
+}

@@ -140,13 +140,20 @@ pub fn trace_pass_with(
 /// miss the scene.
 pub(crate) const MAX_EXTRA: u64 = 16;
 
+/// The least share of a guided global pass's n photons that land where the
+/// camera sees their light (notes/method.md §3, "What the photon count
+/// means with a guide").
+pub(crate) const GUIDED_USEFUL_SHARE: f64 = 0.25;
+
 /// How many photons a global pass asked for `n` emits. Light from
 /// everywhere (a sky, an environment map) emits n over the share of its
 /// photons whose first ray meets the scene, at most [`MAX_EXTRA`] times n,
-/// so that its map holds what n would in a closed scene. A guide does not
-/// change what the photons cost: it spends the same number of photons
-/// whose light the camera sees as that natural emission would (the share
-/// the pilot found useful, natural against guided), from fewer emitted.
+/// so that its map holds what n would in a closed scene. A guided pass
+/// emits as many as land where the camera sees their light what the
+/// natural emission of n would, and at least [`GUIDED_USEFUL_SHARE`] of n
+/// there: the photons that land cost little in the camera pass until
+/// they are many (the volume grid's cells and the irradiance cache grow
+/// with them), and few of them are what makes a window's light noisy.
 pub(crate) fn photons_to_emit(scene: &Scene, n: u64, guide: Option<&EmissionGuide>, seed: u64) -> u64 {
     let natural = match lit_from_outside(scene) {
         true => (n as f64 / landing_fraction(scene, seed).max(1.0 / MAX_EXTRA as f64)).ceil(),
@@ -154,7 +161,8 @@ pub(crate) fn photons_to_emit(scene: &Scene, n: u64, guide: Option<&EmissionGuid
     };
     let Some(g) = guide else { return natural as u64 };
     let (useful, guided) = g.useful_shares(|i| scene.light_prob(i));
-    (natural * (useful / guided).min(1.0)).ceil().max(1.0) as u64
+    let landing = (natural * useful).max(n as f64 * GUIDED_USEFUL_SHARE);
+    (landing / guided).min(natural).ceil().max(1.0) as u64
 }
 
 /// Follows one pilot photon of the global pass ([`EmissionGuide`]) as the
