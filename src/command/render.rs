@@ -17,7 +17,8 @@ use crate::output::read_exr;
 use crate::progress::Mode;
 use crate::provenance::{settings_key, Provenance};
 use crate::render::settings::{
-    default_global_photons, default_vertex_rays, progressive_caustics, Settings, DEFAULT, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP,
+    default_global_photons, default_vertex_rays, progressive_caustics, Settings, DEFAULT, PROGRESSIVE_PHOTONS,
+    PROGRESSIVE_SPP,
 };
 use crate::render::{drive, Budget, Method, Observer, Plan, Stopped};
 use crate::scene::Eye;
