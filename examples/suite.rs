@@ -24,7 +24,7 @@ use photonmap::progress::Mode;
 use photonmap::render::{render, render_progressive, Budget};
 use photonmap::scene::Scene;
 use photonmap::settings::{
-    default_global_photons, progressive_caustics, Settings, DEFAULT, PROGRESSIVE_CAUSTIC_PHOTONS,
+    default_global_photons, default_vertex_rays, progressive_caustics, Settings, DEFAULT, PROGRESSIVE_CAUSTIC_PHOTONS,
     PROGRESSIVE_K_CAUSTIC, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP,
 };
 use photonmap::suite::SuiteScene;
@@ -116,8 +116,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let n = file.rays_per_pixel_edge;
         let scene = Scene::from_parts(file.parts);
         let media = scene.media().is_some();
+        let (gather_rays, shadow_rays) = default_vertex_rays(DEFAULT.method, media);
         let settings = Settings {
             photons: default_global_photons(DEFAULT.photons, media),
+            gather_rays,
+            shadow_rays,
             spp: n * n,
             width: scene.camera.width,
             height: scene.camera.height,

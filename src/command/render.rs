@@ -17,7 +17,8 @@ use crate::output::read_exr;
 use crate::progress::Mode;
 use crate::provenance::{settings_key, Provenance};
 use crate::render::settings::{
-    default_global_photons, progressive_caustics, Settings, DEFAULT, PROGRESSIVE_PHOTONS, PROGRESSIVE_SPP,
+    default_global_photons, default_vertex_rays, progressive_caustics, Settings, DEFAULT, PROGRESSIVE_PHOTONS,
+    PROGRESSIVE_SPP,
 };
 use crate::render::{drive, Budget, Method, Observer, Plan, Stopped};
 use crate::scene::Eye;
@@ -52,6 +53,10 @@ pub struct Request {
     pub caustic_photons: Option<u64>,
     /// None: the default, which differs for progressive renders.
     pub k_caustic: Option<usize>,
+    /// None: the defaults, which differ for photon mapping in a scene with
+    /// media.
+    pub gather_rays: Option<u32>,
+    pub shadow_rays: Option<u32>,
     pub spp: Option<u32>,
     pub width: Option<u32>,
     pub height: Option<u32>,
@@ -152,7 +157,20 @@ pub fn run(req: Request) -> Result<Outcome, Error> {
         Some(given) => given,
         None => default_global_photons(photons, scene.media().is_some()),
     };
-    let settings = Settings { method, photons, caustic_photons, k_caustic, spp, width, height, ..req.settings };
+    let (gather_rays, shadow_rays) = default_vertex_rays(method, scene.media().is_some());
+    let (gather_rays, shadow_rays) = (req.gather_rays.unwrap_or(gather_rays), req.shadow_rays.unwrap_or(shadow_rays));
+    let settings = Settings {
+        method,
+        photons,
+        caustic_photons,
+        k_caustic,
+        spp,
+        width,
+        height,
+        gather_rays,
+        shadow_rays,
+        ..req.settings
+    };
     if let Some(reference) = &reference {
         reference_fits(reference, width, height)?;
     }

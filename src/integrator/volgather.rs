@@ -7,8 +7,8 @@
 //! | that vertex              | estimator at x                               |
 //! |--------------------------|----------------------------------------------|
 //! | the light                | shadow rays (L x), the surface map (L S+ x)  |
-//! | a medium vertex          | the surface map, read directly               |
-//! | a glossy lobe            | the surface map, read directly               |
+//! | a medium vertex          | the surface map, through a cache of its own  |
+//! | a glossy lobe            | the surface map, through a cache of its own  |
 //! | a diffuse lobe, at y     | gather rays: cosine directions from x,      |
 //! |                          | through mirrors, glass and media to y        |
 //!
@@ -126,7 +126,7 @@ impl VolPhotonIntegrator<'_> {
 
     /// The photons' irradiance at `point` from the cache, read from a
     /// cache point no surface hides from it.
-    fn cached(&self, cache: &IrradianceCache, point: glam::Vec3, n: glam::Vec3, ctx: &mut Context) -> Color {
+    pub(super) fn cached(&self, cache: &IrradianceCache, point: glam::Vec3, n: glam::Vec3, ctx: &mut Context) -> Color {
         let scene = self.scene;
         cache.lookup_seen(point, n, cache.locate(point), |from, to| {
             let (dir, len) = ((to - from).normalize_or_zero(), from.distance(to));

@@ -16,8 +16,9 @@
 //! | L D (S\|G)* E                 | shadow rays at the diffuse or glossy vertex |
 //! | L …(S\|D\|V)… D (S\|G)* E     | surface map (global and caustic photons),   |
 //! |                               | read directly at the diffuse vertex; with   |
-//! |                               | final gathering, L … D S* D (S\|G)* E by    |
-//! |                               | gather rays instead ([`super::volgather`])  |
+//! |                               | final gathering, through a cache of it, and |
+//! |                               | L … D S* D (S\|G)* E by gather rays instead |
+//! |                               | ([`super::volgather`])                      |
 //! | L S+ G (S\|G)* E              | emission met after the specular chain       |
 //!
 //! Transmittance along camera segments is exact in both kinds of media
@@ -52,11 +53,17 @@ pub struct VolPhotonIntegrator<'a> {
     /// Photons on diffuse surfaces, read directly at a diffuse camera
     /// vertex: every path but light straight from a light; with `cache`,
     /// only those whose last vertex but specular ones was not a diffuse
-    /// lobe's.
+    /// lobe's, read through `surface_cache`.
     pub surface: &'a PhotonMap,
     /// Final gathering: the irradiance of every surface photon, read at
     /// the gather rays' ends ([`super::volgather`]); `None`: none.
     pub cache: Option<&'a IrradianceCache>,
+    /// With final gathering, `surface`'s irradiance at every stride-th of
+    /// its photons, read at a diffuse camera vertex in place of the k
+    /// nearest photons: a search of the k nearest at every camera sample
+    /// cost 29% of 14-smoke's camera pass for 1.8% of its light
+    /// (notes/method.md §8).
+    pub surface_cache: Option<&'a IrradianceCache>,
     /// Gather rays per diffuse camera vertex.
     pub gather_rays: u32,
     /// Photons scattered in media after a diffuse or medium vertex, as a
@@ -204,8 +211,12 @@ impl VolPhotonIntegrator<'_> {
                 let mut reflected = ctx.checked(direct, "direct");
                 if material.diffuse_rho().is_some() {
                     let rho = material.diffuse_albedo(wo);
-                    let r =
-                        self.surface.radiance_cone(hit.point, frame.n, rho, self.k, self.r_max, &mut thread.scratch);
+                    let r = match self.surface_cache {
+                        Some(read) => rho / std::f32::consts::PI * self.cached(read, hit.point, frame.n, ctx),
+                        None => {
+                            self.surface.radiance_cone(hit.point, frame.n, rho, self.k, self.r_max, &mut thread.scratch)
+                        }
+                    };
                     reflected += ctx.checked(r, "surface map");
                     if let Some(cache) = self.cache {
                         let g = self.gather(cache, &hit, frame.n, medium, ctx);

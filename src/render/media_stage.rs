@@ -123,12 +123,25 @@ pub fn media_pass(
             direct_irradiance_in_media(scene, media, x, n, m, CACHE_SHADOW_RAYS, ctx)
         })
     };
-    let cache = cache_map.as_ref().map(|map| {
-        let stride = settings.cache_stride.unwrap_or_else(|| cache_stride(est.k_global, map.len()));
-        IrradianceCache::build_with(map, stride, est.k_global, est.r_global, &coverage, Some(&direct))
-    });
+    let stride = |map: &PhotonMap| settings.cache_stride.unwrap_or_else(|| cache_stride(est.k_global, map.len()));
+    let (cache, surface_cache) = rayon::join(
+        || {
+            cache_map.as_ref().map(|map| {
+                IrradianceCache::build_with(map, stride(map), est.k_global, est.r_global, &coverage, Some(&direct))
+            })
+        },
+        // The photons read at a diffuse camera vertex, cached as the
+        // gathered ones are (less the lights' own irradiance, which shadow
+        // rays count there).
+        || {
+            gathering.then(|| {
+                IrradianceCache::build_with(&surface, stride(&surface), est.k_global, est.r_global, &coverage, None)
+            })
+        },
+    );
     stats.cache_rays += shadow_rays.into_inner();
     let cache = cache.filter(|c| !c.is_empty());
+    let surface_cache = surface_cache.filter(|c| !c.is_empty());
     stats.cache_time += t.elapsed();
     stats.cache_points = cache.as_ref().map_or(0, |c| c.len());
     stats.global_stored = cache_map.as_ref().map_or(surface.len(), |m| m.len()) + volume.len();
@@ -143,6 +156,7 @@ pub fn media_pass(
         media,
         surface: &surface,
         cache: cache.as_ref(),
+        surface_cache: surface_cache.as_ref(),
         gather_rays: settings.gather_rays,
         volume: &volume,
         volume_caustic: &volume_caustic,

@@ -150,16 +150,18 @@ pub struct RenderArgs {
     /// Largest search radius of a caustic estimate [default: 1% of the diagonal].
     #[arg(long, value_parser = parse_radius)]
     caustic_radius: Option<f32>,
-    /// Final-gather rays per diffuse camera hit (0: no indirect light).
-    #[arg(long, default_value_t = DEFAULT.gather_rays, value_parser = count(0, 65_536))]
-    gather_rays: u32,
+    /// Final-gather rays per diffuse camera hit (0: no indirect light)
+    /// [default: 4; 8 for photon mapping in a scene with media].
+    #[arg(long, value_parser = count(0, 65_536))]
+    gather_rays: Option<u32>,
     /// Of the gather rays, how many are aimed at the mirrors, glass and bright
     /// spots a point sees, if any; one at least stays cosine (0: all do).
     #[arg(long, default_value_t = DEFAULT.aimed_gather_rays, value_parser = count(0, 65_536))]
     aimed_gather_rays: u32,
-    /// Shadow rays per light per diffuse camera hit.
-    #[arg(long, default_value_t = DEFAULT.shadow_rays, value_parser = count(1, 65_536))]
-    shadow_rays: u32,
+    /// Shadow rays per light per diffuse camera hit [default: 2; 4 for
+    /// photon mapping in a scene with media].
+    #[arg(long, value_parser = count(1, 65_536))]
+    shadow_rays: Option<u32>,
     /// Irradiance is precomputed at every N-th stored global photon, and
     /// final-gather rays read the nearest precomputed value [default: k / 6,
     /// 16 at k = 100, following k down in progressive passes].
@@ -218,9 +220,7 @@ impl RenderArgs {
             k_global: self.k as usize,
             r_global: self.max_radius,
             r_caustic: self.caustic_radius,
-            gather_rays: self.gather_rays,
             aimed_gather_rays: self.aimed_gather_rays,
-            shadow_rays: self.shadow_rays,
             edge_spp: self.edge_spp,
             cache_stride: self.cache_stride.map(|n| n as usize),
             caustic_reuse: self.caustic_reuse,
@@ -244,6 +244,8 @@ impl RenderArgs {
             photons: self.photons,
             caustic_photons: self.caustic_photons,
             k_caustic: self.k_caustic.map(|k| k as usize),
+            gather_rays: self.gather_rays,
+            shadow_rays: self.shadow_rays,
             spp: self.spp,
             width: self.width,
             height: self.height,
