@@ -30,7 +30,7 @@ use crate::photon::map::PhotonMap;
 use crate::photon::media_trace::{medium_of, trace_media_pass, MAX_NAMED_MEDIA};
 use crate::photon::trace::Pass;
 use crate::photon::volume_grid::VolumeGrid;
-use crate::photon::volume_map::VolumeMap;
+use crate::photon::volume_map::{VolumeMap, SPARSE_RADIUS};
 use crate::photon::Photon;
 use crate::progress::{Mode, Phase};
 use crate::render::settings::{cache_stride, Settings};
@@ -95,7 +95,12 @@ pub fn media_pass(
         surface.extend(after_diffuse);
         Vec::new()
     };
-    let ((surface, cache_map), (volume, volume_caustic)) = rayon::join(
+    // The volume caustic photons sparser than their mean density (light
+    // the glass scattered about the room, not its cone) join the global
+    // volume photons' grid: read by the beam, their wide spheres were
+    // most of what a camera segment crossed (notes/method.md §8).
+    let mut global_volume = global.volume;
+    let ((surface, cache_map), (volume, volume_caustic, sparse_caustic)) = rayon::join(
         || {
             rayon::join(
                 || PhotonMap::build(surface),
@@ -103,10 +108,10 @@ pub fn media_pass(
             )
         },
         || {
-            rayon::join(
-                || VolumeGrid::build(&global.volume, VOLUME_K, r_volume, narrow),
-                || VolumeMap::build(caustic.volume, VOLUME_K, r_volume, narrow),
-            )
+            let (map, sparse) = VolumeMap::build_dense(caustic.volume, VOLUME_K, r_volume, narrow, SPARSE_RADIUS);
+            let n = sparse.len();
+            global_volume.extend(sparse);
+            (VolumeGrid::build(&global_volume, VOLUME_K, r_volume, narrow), map, n)
         },
     );
     stats.tree_time += t.elapsed();
@@ -144,8 +149,8 @@ pub fn media_pass(
     let surface_cache = surface_cache.filter(|c| !c.is_empty());
     stats.cache_time += t.elapsed();
     stats.cache_points = cache.as_ref().map_or(0, |c| c.len());
-    stats.global_stored = cache_map.as_ref().map_or(surface.len(), |m| m.len()) + volume.len();
-    stats.caustic_stored = volume_caustic.len();
+    stats.global_stored = cache_map.as_ref().map_or(surface.len(), |m| m.len()) + volume.len() - sparse_caustic;
+    stats.caustic_stored = volume_caustic.len() + sparse_caustic;
     stats.map_bytes = surface.memory_bytes()
         + cache_map.as_ref().map_or(0, |m| m.memory_bytes())
         + volume.memory_bytes()
