@@ -402,7 +402,7 @@ impl VolumeMap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampling::{stream, Domain};
+    use crate::sampling::{stream, Domain, Rng};
     use rand::RngExt;
 
     /// The hierarchy finds exactly the photons a brute-force scan finds.
@@ -463,15 +463,10 @@ mod tests {
         assert!((mean - 0.6).abs() < 0.03, "{mean}");
     }
 
-    /// Where the photons crowd into a small part of their box (a volume
-    /// caustic's cone in a room), a photon's sphere is about the one a
-    /// k-nearest search gives it: the first grid's cells, sized for the
-    /// photons spread evenly, span the whole crowd and gave these
-    /// photons spheres about six times too wide.
-    #[test]
-    fn crowded_photons_get_the_k_nearest_radius() {
-        let mut rng = stream(13, Domain::Camera, 3);
-        let (k, sparse, crowd) = (24, 2000, 20_000);
+    /// `sparse` photons of power one spread through a 4 x 4 x 3 room, then
+    /// `crowd` of power `crowd_power` in a cylinder of radius 0.05 and
+    /// length 1 along z at its middle (a volume caustic's cone).
+    fn crowd_in_a_room(rng: &mut Rng, sparse: usize, crowd: usize, crowd_power: f32) -> Vec<VolumePhoton> {
         let room = Vec3::new(4.0, 4.0, 3.0);
         let mut photons: Vec<VolumePhoton> = (0..sparse)
             .map(|_| {
@@ -479,12 +474,23 @@ mod tests {
                 VolumePhoton::new(p, Color::ONE, Vec3::Z, 0)
             })
             .collect();
-        // A cylinder of radius 0.05 and length 1 along z.
         photons.extend((0..crowd).map(|_| {
             let (r, phi) = (0.05 * rng.random::<f32>().sqrt(), std::f32::consts::TAU * rng.random::<f32>());
             let p = Vec3::new(2.0 + r * phi.cos(), 2.0 + r * phi.sin(), 1.0 + rng.random::<f32>());
-            VolumePhoton::new(p, Color::ONE, Vec3::Z, 0)
+            VolumePhoton::new(p, Color::splat(crowd_power), Vec3::Z, 0)
         }));
+        photons
+    }
+
+    /// Where the photons crowd into a small part of their box (a volume
+    /// caustic's cone in a room), a photon's sphere is about the one a
+    /// k-nearest search gives it: the first grid's cells, sized for the
+    /// photons spread evenly, span the whole crowd and gave these
+    /// photons spheres about six times too wide.
+    #[test]
+    fn crowded_photons_get_the_k_nearest_radius() {
+        let (k, sparse, crowd) = (24, 2000, 20_000);
+        let photons = crowd_in_a_room(&mut stream(13, Domain::Camera, 3), sparse, crowd, 1.0);
         let r2 = radii(&photons, k, 0.5, 1.0);
         let mut ratios: Vec<f32> = (sparse..sparse + crowd)
             .step_by(100)
@@ -504,20 +510,8 @@ mod tests {
     /// them, most of the sparse ones about it handed back.
     #[test]
     fn dense_photons_stay_in_the_map_and_sparse_ones_are_handed_back() {
-        let mut rng = stream(17, Domain::Camera, 4);
         let (k, sparse, crowd) = (24, 2000, 20_000);
-        let room = Vec3::new(4.0, 4.0, 3.0);
-        let mut photons: Vec<VolumePhoton> = (0..sparse)
-            .map(|_| {
-                let p = Vec3::new(rng.random(), rng.random(), rng.random()) * room;
-                VolumePhoton::new(p, Color::ONE, Vec3::Z, 0)
-            })
-            .collect();
-        photons.extend((0..crowd).map(|_| {
-            let (r, phi) = (0.05 * rng.random::<f32>().sqrt(), std::f32::consts::TAU * rng.random::<f32>());
-            let p = Vec3::new(2.0 + r * phi.cos(), 2.0 + r * phi.sin(), 1.0 + rng.random::<f32>());
-            VolumePhoton::new(p, Color::splat(2.0), Vec3::Z, 0)
-        }));
+        let photons = crowd_in_a_room(&mut stream(17, Domain::Camera, 4), sparse, crowd, 2.0);
         let whole = VolumeMap::build(photons.clone(), k, 0.5, 0.5);
         let (map, rest) = VolumeMap::build_dense(photons.clone(), k, 0.5, 0.5, 1.0);
         assert_eq!(map.len() + rest.len(), photons.len());
