@@ -86,26 +86,36 @@ pub fn needs(scene: &Scene, targets: &[Target]) -> Needs {
 /// can hold its photons. Measured at a fixed pattern of `samples` points:
 /// each counts where a short ray down from just above it meets a surface
 /// facing as the estimates count one as the same ([`NORMAL_COSINE`])
-/// within twice that height. Beyond an edge nothing is met (or a surface
-/// facing elsewhere); under an object standing on the surface, its
-/// underside is met.
+/// within twice that height, wound as x's own surface is. Beyond an edge
+/// nothing is met (or a surface facing elsewhere); under an object
+/// standing on the surface, its underside is met, wound the other way.
+/// The winding is compared with x's own surface's, met by the same ray
+/// down at x, not with `n`: `n` faces the side the photons came from,
+/// which a surface's winding need not (a room's wall may be wound either
+/// way), and a wall wound outwards measured none of its disk.
 pub fn disk_coverage(scene: &Scene, x: Vertex, n: Vec3, r: f32, samples: u32) -> f32 {
     if !(r > 0.0) || samples == 0 {
         return 1.0;
     }
     let frame = Frame::from_normal(n);
     let height = 0.05 * r + 1e-5 * x.abs().max_element();
+    // The geometric normal of a surface facing like x's met straight
+    // down from just above `q`, if any.
+    let down = |q: Vec3| {
+        let h = scene.intersect(&Ray::new(q + height * n, -n), None).filter(|h| h.t <= 2.0 * height)?;
+        (h.normal.dot(n).abs() >= NORMAL_COSINE).then_some(h.normal)
+    };
+    // x's own winding, from x, else from the first point of the spiral
+    // that meets a surface (an x on an edge may meet none).
+    let mut wound = down(x);
     let mut on = 0;
     for i in 0..samples {
         // A Fermat spiral: equal areas per sample, no random numbers.
         let radius = r * ((i as f32 + 0.5) / samples as f32).sqrt();
         let angle = i as f32 * 2.399_963;
         let q = x + radius * (angle.cos() * frame.s + angle.sin() * frame.t);
-        let ray = Ray::new(q + height * n, -n);
-        if let Some(h) = scene.intersect(&ray, None) {
-            let facing = if h.normal.dot(n) >= 0.0 { h.normal } else { -h.normal };
-            let same_side = h.normal.dot(-n) < 0.0;
-            on += (h.t <= 2.0 * height && same_side && facing.dot(n) >= NORMAL_COSINE) as u32;
+        if let Some(normal) = down(q) {
+            on += (normal.dot(*wound.get_or_insert(normal)) > 0.0) as u32;
         }
     }
     on as f32 / samples as f32
@@ -135,6 +145,35 @@ mod tests {
         assert!(under > 0.1 && under < 0.9, "{under}");
         // On a wall, facing into the room.
         assert_eq!(cover(Vec3::new(5.0, 6.0, 0.0), -Vec3::Y), 1.0);
+    }
+
+    /// A wall wound towards the room or away from it: the same coverage
+    /// on either (photons face the side they came from, whatever the
+    /// winding), and the floor's at the wall's foot the same too.
+    #[test]
+    fn disk_coverage_does_not_depend_on_winding() {
+        let room = |wall: &str| {
+            let text = format!(
+                "[camera]\neye = [2, -3, 1]\ntarget = [2, 2, 1]\nup = [0, 0, 1]\nvfov = 60\nwidth = 8\nheight = 8\n\
+                 [materials.grey]\ntype = \"lambertian\"\nrho = [0.5, 0.5, 0.5]\n\
+                 [[shapes]]\ntype = \"quad\"\nvertices = [[0, 0, 0], [4, 0, 0], [4, 4, 0], [0, 4, 0]]\nmaterial = \"grey\"\n\
+                 [[shapes]]\ntype = \"quad\"\nvertices = {wall}\nmaterial = \"grey\"\n\
+                 [[lights]]\ntype = \"point\"\nposition = [2, 2, 2]\ncolor = [1, 1, 1]\n"
+            );
+            let file = crate::scene::file::parse(&text, std::path::Path::new("room.toml")).expect("a valid scene");
+            Scene::from_parts(file.parts)
+        };
+        // The east wall x = 4, wound towards the room (-x) and away (+x).
+        let inwards = room("[[4, 0, 0], [4, 0, 3], [4, 4, 3], [4, 4, 0]]");
+        let outwards = room("[[4, 0, 0], [4, 4, 0], [4, 4, 3], [4, 0, 3]]");
+        for scene in [&inwards, &outwards] {
+            let cover = |x: Vec3, n: Vec3| disk_coverage(scene, x, n, 0.5, 256);
+            let wall_foot = cover(Vec3::new(4.0, 2.0, 0.0), -Vec3::X);
+            assert!((wall_foot - 0.5).abs() < 0.03, "{wall_foot}");
+            assert_eq!(cover(Vec3::new(4.0, 2.0, 1.5), -Vec3::X), 1.0);
+            let floor_by_wall = cover(Vec3::new(4.0, 2.0, 0.0), Vec3::Z);
+            assert!((floor_by_wall - 0.5).abs() < 0.03, "{floor_by_wall}");
+        }
     }
 
     /// A target per object with a mirror or glass lobe, holding every such
