@@ -73,3 +73,17 @@ fn a_thin_lens_is_thread_independent() {
     let pinhole = Scene::tncg15(Eye::One);
     assert_ne!(render_quiet(&scene, &path), render_quiet(&pinhole, &path));
 }
+
+/// Volumetric photon mapping, whose camera samples take their gather and
+/// shadow rays' points from sequences of their pixel's: the same image on
+/// any number of threads, in one pass and in two.
+#[test]
+fn volumetric_photon_mapping_is_thread_independent() {
+    let (_, scene, _) = suite_scene("14-smoke");
+    let settings =
+        Settings { photons: 4_000, caustic_photons: 4_000, spp: 2, width: 20, height: 20, ..Settings::default() };
+    check_thread_independence(|seed| render_quiet(&scene, &Settings { seed, ..settings }));
+    check_thread_independence(|seed| {
+        render_progressive(&scene, &Settings { seed, spp: 1, ..settings }, Budget::passes(2), |_| {}).0
+    });
+}

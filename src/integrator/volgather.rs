@@ -23,6 +23,7 @@
 //! the gather ray is the surface map's at x (a medium vertex's row), so
 //! the gather ray needs no beam estimate.
 
+use super::photon::gather::GatherSequence;
 use super::volpath::transmittance;
 use super::volphoton::VolPhotonIntegrator;
 use super::Context;
@@ -51,6 +52,7 @@ impl VolPhotonIntegrator<'_> {
         hit: &Hit,
         n: glam::Vec3,
         medium: Option<u32>,
+        sequence: Option<(u64, u64)>,
         ctx: &mut Context,
     ) -> Color {
         let count = self.gather_rays;
@@ -59,8 +61,13 @@ impl VolPhotonIntegrator<'_> {
         }
         let frame = Frame::from_normal(n);
         let mut sum = Color::ZERO;
+        let sequence = sequence.map(|(index, scramble)| GatherSequence::new(index, scramble, count));
         for g in 0..count {
-            let dir = frame.to_world(cosine_hemisphere(stratified_2d(g, count, next_2d(ctx.rng)))).normalize();
+            let u = match &sequence {
+                Some(s) => s.point(g),
+                None => stratified_2d(g, count, next_2d(ctx.rng)),
+            };
+            let dir = frame.to_world(cosine_hemisphere(u)).normalize();
             // About a shading normal a gather ray may point into the
             // surface: it gathers nothing.
             if !(dir.dot(n) > 0.0) || (hit.shading_normal != hit.normal && !hit.leaves_as(-n, dir, true)) {

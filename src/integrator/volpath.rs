@@ -28,6 +28,7 @@
 
 use super::mis::power_heuristic;
 use super::path::PathIntegrator;
+use super::photon::gather::GatherSequence;
 use super::{Context, Part};
 use crate::light::{Incident, Light};
 use crate::material::{Branch, Lobe, Material, Transport};
@@ -178,7 +179,7 @@ pub(super) fn radiance(pt: &PathIntegrator, media: &Media, ray: Ray, part: Part,
         vertices += 1;
         let smooth = scatter.lobe != Lobe::Specular;
         if material.has_smooth_lobes() && within(vertices + 1) {
-            let direct = surface_light(scene, media, &hit, &material, &frame, wo, entering, medium, true, 1, ctx);
+            let direct = surface_light(scene, media, &hit, &material, &frame, wo, entering, medium, true, 1, None, ctx);
             radiance += throughput * ctx.checked(direct, "volpath surface light");
         }
         let dir = frame.to_world(scatter.wi).normalize();
@@ -380,18 +381,28 @@ pub(super) fn surface_light(
     medium: Option<u32>,
     mis: bool,
     count: u32,
+    sequence: Option<(u64, u64)>,
     ctx: &mut Context,
 ) -> Color {
     let count = count.max(1);
+    // A camera sample's shadow rays take their block of a sequence of the
+    // pixel's, scrambled apart from its gather rays' (as those, they stay
+    // stratified over the light across the pixel's samples and passes).
+    let sequence = sequence.map(|(index, scramble)| GatherSequence::new(index, scramble ^ SHADOW_SEQUENCE, count));
     let mut sum = Color::ZERO;
     for s in 0..count {
-        sum += surface_light_sample(scene, media, hit, material, frame, wo, entering, medium, mis, (s, count), ctx);
+        let point = sequence.as_ref().map(|q| q.point(s));
+        sum +=
+            surface_light_sample(scene, media, hit, material, frame, wo, entering, medium, mis, (s, count), point, ctx);
     }
     sum / count as f32
 }
 
-/// One shadow ray of [`surface_light`]: its sample of the light in
-/// stratum `stratum.0` of `stratum.1`.
+/// Keys the shadow rays' sequence apart from the gather rays'.
+const SHADOW_SEQUENCE: u64 = 0x5AD0_5EED_0000_0002;
+
+/// One shadow ray of [`surface_light`]: its sample of the light at
+/// `point`, or in stratum `stratum.0` of `stratum.1`.
 #[allow(clippy::too_many_arguments)]
 fn surface_light_sample(
     scene: &Scene,
@@ -404,14 +415,16 @@ fn surface_light_sample(
     medium: Option<u32>,
     mis: bool,
     stratum: (u32, u32),
+    point: Option<glam::Vec2>,
     ctx: &mut Context,
 ) -> Color {
     let Some((index, chance)) = scene.pick_light_index(ctx.rng.random::<f32>()) else { return Color::ZERO };
     let light = &scene.lights[index];
     let n = frame.n;
-    let u = match stratum {
-        (_, 1) => next_2d(ctx.rng),
-        (s, count) => crate::sampling::stratified_2d(s, count, next_2d(ctx.rng)),
+    let u = match (point, stratum) {
+        (Some(u), _) => u,
+        (None, (_, 1)) => next_2d(ctx.rng),
+        (None, (s, count)) => crate::sampling::stratified_2d(s, count, next_2d(ctx.rng)),
     };
     let Some(inc) = light.sample_li(hit.point, n, u) else { return Color::ZERO };
     let wi = frame.to_local(inc.dir);

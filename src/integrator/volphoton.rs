@@ -132,23 +132,57 @@ fn lit_grid(scene: &Scene, media: &Media, m: u32, counters: &mut crate::stats::C
     LitGrid::new(lo, hi, res, &light)
 }
 
+/// What a pixel's samples share: the camera sample's place in the
+/// pixel's sequence over all passes and the pixel's scramble
+/// ([`Integrator::start_sample`]), for the first diffuse vertex's gather
+/// rays, which then stay stratified over the hemisphere across the pixel's
+/// samples and passes, as in a scene without media.
+#[derive(Default)]
+pub struct VolPhotonPixel {
+    sequence: Option<(u64, u64)>,
+}
+
 impl Integrator for VolPhotonIntegrator<'_> {
     type Thread = VolPhotonThread;
-    type Pixel = ();
+    type Pixel = VolPhotonPixel;
 
-    fn radiance(&self, ray: Ray, part: Part, ctx: &mut Context, thread: &mut VolPhotonThread, _: &mut ()) -> Color {
+    fn radiance(
+        &self,
+        ray: Ray,
+        part: Part,
+        ctx: &mut Context,
+        thread: &mut VolPhotonThread,
+        pixel: &mut VolPhotonPixel,
+    ) -> Color {
+        let sequence = pixel.sequence.take();
         // A whole sample is the two parts apart: the emitted part follows
         // both branches at glass, where the path follows one.
         match part {
             Part::Emitted => emitted_part(self.scene, self.media, ray, ctx),
-            Part::Reflected => self.path(ray, part, ctx, thread),
-            Part::All => emitted_part(self.scene, self.media, ray, ctx) + self.path(ray, Part::Reflected, ctx, thread),
+            Part::Reflected => self.path(ray, part, sequence, ctx, thread),
+            Part::All => {
+                emitted_part(self.scene, self.media, ray, ctx) + self.path(ray, Part::Reflected, sequence, ctx, thread)
+            }
         }
+    }
+
+    fn start_sample(&self, pixel: &mut VolPhotonPixel, index: u64, scramble: u64) {
+        pixel.sequence = Some((index, scramble));
     }
 }
 
 impl VolPhotonIntegrator<'_> {
-    fn path(&self, mut ray: Ray, part: Part, ctx: &mut Context, thread: &mut VolPhotonThread) -> Color {
+    /// `sequence`: the camera sample's place in its pixel's sequence and
+    /// the pixel's scramble, whose block of points the first diffuse
+    /// vertex's gather rays take ([`super::photon::gather::GatherSequence`]).
+    fn path(
+        &self,
+        mut ray: Ray,
+        part: Part,
+        mut sequence: Option<(u64, u64)>,
+        ctx: &mut Context,
+        thread: &mut VolPhotonThread,
+    ) -> Color {
         let (scene, media) = (self.scene, self.media);
         let hide_emitters = scene.paths.hide_emitters;
         let mut radiance = Color::ZERO;
@@ -195,6 +229,9 @@ impl VolPhotonIntegrator<'_> {
             let (frame, entering) = hit.scattering_frame(ray.dir, &material);
             let wo = frame.to_local(-ray.dir);
             if material.has_smooth_lobes() {
+                // The first such vertex's rays take the sample's block of
+                // the pixel's sequences.
+                let vertex_sequence = sequence.take();
                 let direct = surface_light(
                     scene,
                     media,
@@ -206,6 +243,7 @@ impl VolPhotonIntegrator<'_> {
                     medium,
                     false,
                     self.shadow_rays,
+                    vertex_sequence,
                     ctx,
                 );
                 let mut reflected = ctx.checked(direct, "direct");
@@ -219,7 +257,7 @@ impl VolPhotonIntegrator<'_> {
                     };
                     reflected += ctx.checked(r, "surface map");
                     if let Some(cache) = self.cache {
-                        let g = self.gather(cache, &hit, frame.n, medium, ctx);
+                        let g = self.gather(cache, &hit, frame.n, medium, vertex_sequence, ctx);
                         reflected += rho * g;
                     }
                 }

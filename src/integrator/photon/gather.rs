@@ -27,14 +27,14 @@ pub(super) fn gather_density(cos: f32, nc: u32, na: u32, aimed_pdf: impl FnOnce(
 /// rays stay stratified over the hemisphere across passes, where rays
 /// drawn anew each pass add independent noise. Each point on its own is
 /// uniform: unbiased.
-pub(super) struct GatherSequence {
+pub(crate) struct GatherSequence {
     /// The unscrambled bits of the block's first point.
     base: [u32; 2],
     key: u64,
 }
 
 impl GatherSequence {
-    pub(super) fn new(index: u64, scramble: u64, count: u32) -> Self {
+    pub(crate) fn new(index: u64, scramble: u64, count: u32) -> Self {
         let key = splitmix64(scramble ^ GATHER_SEQUENCE);
         let shift = count.max(1).next_power_of_two().trailing_zeros();
         let sample = shuffled_index(index as u32, (key >> 32) as u32);
@@ -44,7 +44,7 @@ impl GatherSequence {
     }
 
     /// Ray `g`'s point (`g` below the block's size).
-    pub(super) fn point(&self, g: u32) -> glam::Vec2 {
+    pub(crate) fn point(&self, g: u32) -> glam::Vec2 {
         let [x, y] = sobol_2d_bits(g);
         owen_2d([self.base[0] ^ x, self.base[1] ^ y], self.key)
     }

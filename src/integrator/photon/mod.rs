@@ -34,7 +34,7 @@ use crate::shape::Departure;
 use rand::RngExt;
 use std::f32::consts::PI;
 
-mod gather;
+pub(crate) mod gather;
 use gather::gather_density;
 
 /// Camera paths split into both the reflected and refracted branch at their
