@@ -75,14 +75,15 @@ fn phase_functions_sample_their_density() {
 /// χ²: single scattering's distances drawn by transmittance times a grid
 /// of where the lights reach (`LitSegment`), grey, chromatic and nearly
 /// clear media, a segment ending inside the grid and one reaching to
-/// infinity, and a heterogeneous medium's box drawn by the segment's
-/// transmittance across it, follow the density they report (40 bins along the first
+/// infinity, a heterogeneous medium's box drawn by the segment's
+/// transmittance across it, and the same segment tracked (drawn as its
+/// σ_t T falls, [`LitSegment::build`]), follow the density they report (40 bins along the first
 /// `span` of the segment and one for the rest; each bin's expected count
 /// is the density integrated by a 4,000-step midpoint rule, the jumps at
 /// the cells' ends within it costing under 10⁻⁴ of a bin).
 #[test]
 fn lit_distances_follow_their_density() {
-    use photonmap::medium::{LitGrid, LitSegment};
+    use photonmap::medium::{LitGrid, LitSegment, Steps};
     let albedo = Volume::Constant { value: Color::ONE, to_world: Affine3A::IDENTITY };
     let grid = LitGrid::speckled(3);
     let cases = [
@@ -93,19 +94,27 @@ fn lit_distances_follow_their_density() {
         // Heterogeneous (`smoke()`, its box [-1, 1]³): the colour is the
         // transmittance across the segment, one channel nearly clear.
         (Color::new(0.3, 0.6, 0.999_99), Vec3::new(-1.5, 0.1, 0.3), Vec3::new(1.0, 0.2, 0.35), 6.0, 6.0),
+        // The same smoke, the segment tracked: drawn as σ_t T falls along
+        // it, each channel's (the grid's three differ).
+        (Color::ONE, Vec3::new(-1.5, 0.1, 0.3), Vec3::new(1.0, 0.2, 0.35), 6.0, 6.0),
     ];
     let chi2 = Chi2 { samples: 200_000, tests: cases.len(), ..Chi2::default() };
     let mut failed = Vec::new();
     for (k, &(sigma, o, d, t_max, span)) in cases.iter().enumerate() {
-        let heterogeneous = k == cases.len() - 1;
+        let (heterogeneous, tracked) = (k >= cases.len() - 2, k == cases.len() - 1);
         let m = match heterogeneous {
             true => smoke(),
             false => Medium::homogeneous(sigma, albedo.clone(), 1.0, Phase::Isotropic).unwrap(),
         };
         let ray = Ray::new(o, d.normalize());
         let mut seg = LitSegment::default();
-        let across = if heterogeneous { sigma } else { Color::ONE };
-        assert!(seg.build(&m, &grid, &ray, t_max, across), "case {k}");
+        let mut steps = Steps::default();
+        let across = match (heterogeneous, tracked) {
+            (_, true) => m.track(&ray, t_max, &mut steps),
+            (true, false) => sigma,
+            _ => Color::ONE,
+        };
+        assert!(seg.build(&m, &grid, &ray, t_max, across, &steps), "case {k}");
         let bins = 40;
         let bin = |t: f32| if t >= span { bins } else { ((t / span * bins as f32) as usize).min(bins - 1) };
         let mut observed = vec![0.0f64; bins + 1];

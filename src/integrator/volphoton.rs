@@ -321,7 +321,7 @@ impl VolPhotonIntegrator<'_> {
         thread: &mut VolPhotonThread,
     ) -> Color {
         let grid = self.media.lit_grid(m, || lit_grid(self.scene, self.media, m, ctx.counters));
-        let drawable = thread.lit.build(med, grid, ray, t_max, across);
+        let drawable = thread.lit.build(med, grid, ray, t_max, across, &thread.steps);
         let steps = &thread.steps;
         let mut sum = Color::ZERO;
         self.volume_caustic.beam(ray, t_max, |c| {

@@ -21,7 +21,7 @@ pub struct Steps {
     /// A heterogeneous segment's knots (distance, transmittance from 0 to
     /// it), increasing, read by linear interpolation between them; before
     /// the first 1, after the last the last.
-    steps: Vec<(f32, Color)>,
+    pub(super) steps: Vec<(f32, Color)>,
     /// A homogeneous medium's transmittance at evenly spaced distances
     /// `spacing` apart (empty: computed exactly), read by linear interpolation: the beam
     /// estimate asks it at each of hundreds of photons per segment, where
