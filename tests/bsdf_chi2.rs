@@ -10,7 +10,7 @@ mod common;
 
 use common::chi2::{gamma_q, Chi2};
 use glam::Vec3;
-use photonmap::material::{Distribution, Material, Microfacet, Phong};
+use photonmap::material::{Distribution, Material, Microfacet, Phong, Transport};
 use photonmap::math::Color;
 use photonmap::sampling::{next_2d, stream, Domain};
 
@@ -118,6 +118,68 @@ fn plastics_lambertian_and_phong_samples_follow_their_pdfs() {
         }
     }
     check_all("diffuse and coated", cases);
+}
+
+/// A glossy lobe sampled at given points of the unit square (the camera
+/// pass's stratified gather rays at a glossy vertex, `Glossy::sample_at`)
+/// draws by the lobe's own pdf where the points are uniform: rough glass
+/// from both sides, a rough metal, a rough plastic's coat, Phong's lobe.
+#[test]
+fn glossy_lobes_sampled_at_given_points_follow_their_pdf() {
+    let phong = Phong {
+        color: Color::new(0.9, 0.6, 0.3),
+        ambient: 0.0,
+        diffuse: 0.4,
+        specular: 0.3,
+        metalness: 0.2,
+        shininess: 20.0,
+        mirror: 0.0,
+    };
+    let mut materials = vec![("phong".to_string(), Material::Phong(phong))];
+    for d in DISTRIBUTIONS {
+        for (au, av) in ROUGHNESS {
+            let name = format!("{} {au}/{av}", d.name());
+            materials.push((
+                format!("roughdielectric {name}"),
+                Material::rough_dielectric(d, au, av, 1.5, 1.0, Color::ONE, Color::ONE),
+            ));
+            materials.push((
+                format!("roughconductor {name}"),
+                Material::rough_conductor(d, au, av, Color::new(0.2, 0.9, 1.1), Color::new(3.9, 2.4, 2.2), Color::ONE),
+            ));
+        }
+        materials.push((
+            format!("roughplastic {}", d.name()),
+            Material::rough_plastic(d, 0.2, Color::new(0.6, 0.3, 0.1), Color::ONE, 1.49, 1.0, true),
+        ));
+    }
+    let mut cases = Vec::new();
+    for (name, m) in &materials {
+        for wo in incidences() {
+            for entering in [true, false] {
+                cases.push((name.clone(), *m, wo, entering));
+            }
+        }
+    }
+    let n = cases.len();
+    let mut failed = Vec::new();
+    for (i, (name, m, wo, entering)) in cases.into_iter().enumerate() {
+        let g = m.glossy().expect("a glossy lobe");
+        let mut rng = stream(17, Domain::Camera, i as u64);
+        let mut choice = stream(18, Domain::Camera, i as u64);
+        let o = Chi2 { tests: n, ..Chi2::default() }.run(
+            || g.sample_at(wo, entering, Transport::Radiance, next_2d(&mut rng), &mut choice).map(|(wi, _)| wi),
+            |wi| g.pdf(wo, wi, entering) as f64,
+        );
+        println!(
+            "{name} wo {wo:.2} entering {entering}: chi2 {:.1} dof {} p {:.4} mass {:.4}",
+            o.statistic, o.dof, o.p_value, o.pdf_mass
+        );
+        if !o.passed() {
+            failed.push(format!("{name} {wo} {entering}: p {}", o.p_value));
+        }
+    }
+    assert!(failed.is_empty(), "{failed:?}");
 }
 
 /// The harness has power: a cosine sampler tested against the uniform

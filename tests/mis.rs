@@ -189,6 +189,20 @@ struct Blocks {
 /// Renders `passes` passes of one sample per pixel at `size`², each pass
 /// on its own streams, and summarises `blocks`² blocks.
 fn blocks<I: Integrator>(integrator: &I, scene: &Scene, size: u32, passes: u32, seed: u64) -> Blocks {
+    blocks_with(integrator, scene, size, passes, seed, false)
+}
+
+/// [`blocks`], where `sequenced` each sample told its place in its pixel's
+/// sequence (the pass) and the pixel's scramble, as the camera pass tells
+/// it (`Integrator::start_sample`).
+fn blocks_with<I: Integrator>(
+    integrator: &I,
+    scene: &Scene,
+    size: u32,
+    passes: u32,
+    seed: u64,
+    sequenced: bool,
+) -> Blocks {
     const B: u32 = 4;
     let camera = scene.camera.with_resolution(size, size);
     let n = (B * B) as usize;
@@ -202,6 +216,10 @@ fn blocks<I: Integrator>(integrator: &I, scene: &Scene, size: u32, passes: u32, 
             let mut rng = stream(seed, Domain::Camera, (pass * size * size + pixel) as u64);
             let mut ctx = Context { rng: &mut rng, counters: &mut counters, pixel: pixel as u64 };
             let mut state = I::Pixel::default();
+            if sequenced {
+                let scramble = photonmap::sampling::splitmix64(seed ^ photonmap::sampling::splitmix64(pixel as u64));
+                integrator.start_sample(&mut state, pass as u64, scramble);
+            }
             let ray = camera.ray(col, row, next_2d(ctx.rng));
             let l = integrator.radiance(ray, Part::All, &mut ctx, &mut thread, &mut state)
                 + integrator.finish(&mut ctx, &mut thread, &mut state);
@@ -487,6 +505,28 @@ fn rough_glass_splits_agree_in_the_mean_with_less_noise() {
     let ratio = split.var.iter().sum::<f64>() / chosen.var.iter().sum::<f64>();
     eprintln!("variance split / chosen: {ratio:.3}");
     assert!(ratio < 0.7, "{ratio}");
+}
+
+/// A camera path's first glossy vertex takes its rays' microfacet normals
+/// (and each ray's path its next glossy sample) from the pixel's scrambled
+/// Sobol sequences: the same mean as independent random numbers (the same
+/// photon maps for both), and less noise over the ball from one sample to
+/// the next (measured: variance x 0.71 over these blocks, 1000 passes).
+#[test]
+fn stratified_glossy_rays_agree_in_the_mean_with_less_noise() {
+    let scene = frosted_ball();
+    let settings = Settings { photons: 40_000, caustic_photons: 40_000, gather_rays: 4, ..Settings::default() };
+    let est = Estimates::progressive(&scene, &settings, 0);
+    let maps = photon_pass(&scene, &settings, 0, est, Mode::Quiet, &mut Stats::default());
+    let mut integrator = photon_integrator(&scene, &settings, &maps, est);
+    assert!(integrator.settings.stratify_glossy);
+    let stratified = blocks_with(&integrator, &scene, 16, 1000, 45, true);
+    integrator.settings.stratify_glossy = false;
+    let random = blocks_with(&integrator, &scene, 16, 1000, 46, true);
+    assert_agree("frosted ball, stratified glossy rays against random", &stratified, &random);
+    let ratio = stratified.var.iter().sum::<f64>() / random.var.iter().sum::<f64>();
+    eprintln!("variance stratified / random: {ratio:.3}");
+    assert!(ratio < 0.85, "{ratio}");
 }
 
 /// Where a gather path splits at rough glass and the reflected branch

@@ -18,7 +18,7 @@ use super::plastic::RoughPlastic;
 use super::{Phong, Principled, PrincipledThin, Transport};
 use crate::math::Color;
 use crate::sampling::{next_2d, Rng};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use rand::RngExt;
 
 /// Below this microfacet roughness (the larger alpha), a glossy lobe
@@ -86,6 +86,46 @@ impl Glossy<'_> {
                 let u1 = rng.random::<f32>();
                 p.sample_glossy(wo, u1, next_2d(rng))
             }
+        }
+    }
+
+    /// [`Self::sample`] with the lobe's 2D sample (the microfacet normal,
+    /// or the direction about the lobe's axis) given as `u`, a point of a
+    /// stratified sequence; a lobe that also chooses (rough glass's
+    /// Fresnel choice, a principled lobe's) draws that number from `rng`.
+    /// The same warp: `u` uniform gives [`Self::pdf`].
+    pub fn sample_at(
+        &self,
+        wo: Vec3,
+        entering: bool,
+        mode: Transport,
+        u: Vec2,
+        rng: &mut Rng,
+    ) -> Option<(Vec3, Color)> {
+        match self {
+            Glossy::Phong(p) => p.sample_glossy(wo, u),
+            Glossy::Conductor(c) => c.sample(wo, u),
+            Glossy::Dielectric(d) => d.sample(wo, entering, mode, rng.random::<f32>(), u),
+            Glossy::Coat(p) => p.sample_coat(wo, u),
+            Glossy::Principled(p) => p.sample_glossy(wo, mode, rng.random::<f32>(), u),
+            Glossy::Thin(p) => p.sample_glossy(wo, rng.random::<f32>(), u),
+        }
+    }
+
+    /// [`Self::sample_split`] with the lobe's 2D sample given as `u`
+    /// ([`Self::sample_at`]).
+    pub fn sample_split_at(
+        &self,
+        wo: Vec3,
+        entering: bool,
+        mode: Transport,
+        split: bool,
+        u: Vec2,
+        rng: &mut Rng,
+    ) -> [Option<(Vec3, Color)>; 2] {
+        match self {
+            Glossy::Dielectric(d) if split => d.sample_both(wo, entering, mode, u),
+            _ => [self.sample_at(wo, entering, mode, u, rng), None],
         }
     }
 

@@ -337,6 +337,7 @@ pub fn photon_integrator<'a>(
             mis: true,
             rough_splits: crate::integrator::photon::ROUGH_SPLITS,
             reflected_paths: crate::integrator::photon::REFLECTED_PATHS,
+            stratify_glossy: true,
         },
     }
 }

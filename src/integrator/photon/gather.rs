@@ -118,7 +118,7 @@ impl<'a> PhotonIntegrator<'a> {
                 BsdfSample { compensated: true, ..self.bsdf_sample(hit, n, pdf) }
             });
             let (ray, dep) = hit.spawn(dir);
-            sum += c * self.gather(ray, dep, Lobe::Diffuse, sample, 0, w * rho * c, sh);
+            sum += c * self.gather(ray, dep, Lobe::Diffuse, sample, 0, None, w * rho * c, sh);
         }
         rho * sum
     }
@@ -169,6 +169,10 @@ impl<'a> PhotonIntegrator<'a> {
     /// ([`ROUGH_SPLITS`]): the reflected one by a gather of its own, by
     /// [`REFLECTED_PATHS`] of them, each about a normal of its own, where
     /// it carries most of the light.
+    ///
+    /// `at`: the point of the unit square that the path's first glossy
+    /// sample takes (a scrambled Sobol sequence's, stratified across the
+    /// pixel's samples), in place of two random numbers.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn gather(
         &self,
@@ -177,6 +181,7 @@ impl<'a> PhotonIntegrator<'a> {
         mut from: Lobe,
         mut shared: Option<BsdfSample>,
         mut splits: u32,
+        mut at: Option<glam::Vec2>,
         w: Color,
         sh: &mut Shade<'_, '_, 'a>,
     ) -> Color {
@@ -251,7 +256,10 @@ impl<'a> PhotonIntegrator<'a> {
             } else {
                 let Some(g) = glossy else { break };
                 let split = splits > 0 && !caustic_glossy && g.splits();
-                let [first, second] = g.sample_split(wo, entering, Transport::Radiance, split, sh.ctx.rng);
+                let [first, second] = match at.take() {
+                    Some(u) => g.sample_split_at(wo, entering, Transport::Radiance, split, u, sh.ctx.rng),
+                    None => g.sample_split(wo, entering, Transport::Radiance, split, sh.ctx.rng),
+                };
                 if split {
                     // The reflected branch by a gather of its own, the
                     // refracted one on in this loop.
@@ -277,7 +285,8 @@ impl<'a> PhotonIntegrator<'a> {
                             let sample = mis.map(|g| self.bsdf_sample(&y, frame.n, pdf(g)));
                             let (next, next_dep) = y.spawn(dir);
                             let weight = weight * gw / ((1.0 - p_specular) * paths as f32);
-                            found += weight * self.gather(next, next_dep, Lobe::Glossy, sample, splits, w * weight, sh);
+                            found += weight
+                                * self.gather(next, next_dep, Lobe::Glossy, sample, splits, None, w * weight, sh);
                         }
                     }
                 }

@@ -35,7 +35,14 @@ use rand::RngExt;
 use std::f32::consts::PI;
 
 pub(crate) mod gather;
-use gather::gather_density;
+use gather::{gather_density, GatherSequence};
+
+/// Keys the glossy lobe's sequence apart from the diffuse gather rays'
+/// (a plastic's base and coat at the same vertex).
+const GLOSSY_SEQUENCE: u64 = 0x6105_5EED_0000_0002;
+/// Keys the sequence of the glossy sample at the next vertex of each of
+/// those rays' paths.
+const GLOSSY_SEQUENCE_NEXT: u64 = 0x6105_5EED_0000_0003;
 
 /// Camera paths split into both the reflected and refracted branch at their
 /// first glass vertices (no noise from the choice where it matters most);
@@ -107,6 +114,12 @@ pub struct PhotonEstimator {
     /// ([`REFLECTED_PATHS`]; 1: one, the estimate it must agree with in
     /// the mean).
     pub reflected_paths: u32,
+    /// Whether a camera path's first glossy vertex draws its gather rays'
+    /// microfacet normals (the lobe's 2D samples), and each of their paths
+    /// its next glossy sample, from the pixel's scrambled Sobol sequences
+    /// ([`gather::GatherSequence`]) instead of independent random numbers
+    /// (off: the estimate it must agree with in the mean).
+    pub stratify_glossy: bool,
 }
 
 /// A read of precomputed irradiance that a camera sample leaves for later:
@@ -383,15 +396,33 @@ impl<'a> PhotonIntegrator<'a> {
             // the two sum to one).
             let split = s.rough_splits > 0 && g.splits();
             let splits = s.rough_splits - split as u32;
-            for _ in 0..glossy_rays {
-                let branches = g.sample_split(wo, entering, Transport::Radiance, split, sh.ctx.rng);
+            // The lobe's rays take their 2D samples from a scrambled Sobol
+            // sequence of the pixel, as a diffuse point's cosine rays do
+            // (keyed apart from theirs): stratified over the lobe within
+            // the camera sample and across the pixel's samples and passes;
+            // and so does the next glossy sample on each ray's path (a
+            // frosted ball's far side), from a second sequence. Light seen
+            // through two rough surfaces is found where the first one's
+            // normal lines the second's lobe up with the light: random
+            // normals left it in rare bright samples.
+            let sequence = sh.pixel.sequence.filter(|_| s.stratify_glossy).map(|(index, scramble)| {
+                let at = |key| GatherSequence::new(index, scramble ^ key, glossy_rays);
+                (at(GLOSSY_SEQUENCE), at(GLOSSY_SEQUENCE_NEXT))
+            });
+            for r in 0..glossy_rays {
+                let branches = match &sequence {
+                    Some((q, _)) => g.sample_split_at(wo, entering, Transport::Radiance, split, q.point(r), sh.ctx.rng),
+                    None => g.sample_split(wo, entering, Transport::Radiance, split, sh.ctx.rng),
+                };
+                let next_at = sequence.as_ref().map(|(_, q)| q.point(r));
                 for (wi, weight) in branches.into_iter().flatten() {
                     let dir = frame.to_world(wi).normalize();
                     if hit.leaves_as(-frame.n, dir, wi.z > 0.0) {
                         let (next, dep) = hit.spawn(dir);
                         let sample = mis.map(|g| self.bsdf_sample(hit, n, rays * g.pdf(wo, wi, entering)));
                         let weight = weight / rays;
-                        indirect += weight * self.gather(next, dep, Lobe::Glossy, sample, splits, w * weight, sh);
+                        indirect +=
+                            weight * self.gather(next, dep, Lobe::Glossy, sample, splits, next_at, w * weight, sh);
                     }
                 }
             }
