@@ -299,17 +299,7 @@ impl LitSegment {
     /// missed the dense puffs of a smoke and piled into its thin parts,
     /// whose σ_s then weighed them down.
     fn build_tracked(&mut self, knots: &[(f32, Color)], start: f32) -> bool {
-        let at = |t: f32| -> Color {
-            match knots.partition_point(|k| k.0 <= t) {
-                0 => Color::ONE,
-                i if i == knots.len() => knots[i - 1].1,
-                i => {
-                    let ((ta, a), (tb, b)) = (knots[i - 1], knots[i]);
-                    let f = if tb > ta { (t - ta) / (tb - ta) } else { 0.0 };
-                    a + (b - a) * f
-                }
-            }
-        };
+        let at = |t: f32| super::segment::between_knots(knots, t);
         let last = knots[knots.len() - 1].1;
         // Channels whose transmittance falls alike are drawn as one.
         let channels: &[usize] = if last.x == last.y && last.y == last.z { &[0] } else { &[0, 1, 2] };

@@ -108,18 +108,23 @@ impl Medium {
                 let f = x - i as f32;
                 steps.table[i] + (steps.table[i + 1] - steps.table[i]) * f
             }
-            Kind::Heterogeneous { .. } => {
-                let knots = &steps.steps;
-                match knots.partition_point(|s| s.0 <= t) {
-                    0 => Color::ONE,
-                    i if i == knots.len() => knots[i - 1].1,
-                    i => {
-                        let ((ta, a), (tb, b)) = (knots[i - 1], knots[i]);
-                        let f = if tb > ta { (t - ta) / (tb - ta) } else { 0.0 };
-                        a + (b - a) * f
-                    }
-                }
-            }
+            Kind::Heterogeneous { .. } => between_knots(&steps.steps, t),
+        }
+    }
+}
+
+/// The transmittance at `t` read from a heterogeneous segment's `knots`
+/// (increasing distances, transmittance to each) by linear interpolation:
+/// 1 before the first, the last after it.
+#[inline]
+pub(super) fn between_knots(knots: &[(f32, Color)], t: f32) -> Color {
+    match knots.partition_point(|s| s.0 <= t) {
+        0 => Color::ONE,
+        i if i == knots.len() => knots[i - 1].1,
+        i => {
+            let ((ta, a), (tb, b)) = (knots[i - 1], knots[i]);
+            let f = if tb > ta { (t - ta) / (tb - ta) } else { 0.0 };
+            a + (b - a) * f
         }
     }
 }
