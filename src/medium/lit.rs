@@ -300,9 +300,10 @@ impl LitSegment {
     /// whose σ_s then weighed them down.
     fn build_tracked(&mut self, knots: &[(f32, Color)], start: f32) -> bool {
         let at = |t: f32| super::segment::between_knots(knots, t);
-        let last = knots[knots.len() - 1].1;
-        // Channels whose transmittance falls alike are drawn as one.
-        let channels: &[usize] = if last.x == last.y && last.y == last.z { &[0] } else { &[0, 1, 2] };
+        // Channels whose transmittance falls alike all along are drawn as
+        // one (a grey medium's).
+        let grey = knots.iter().all(|k| k.1.x == k.1.y && k.1.y == k.1.z);
+        let channels: &[usize] = if grey { &[0] } else { &[0, 1, 2] };
         let lit = std::mem::take(&mut self.pieces);
         let mut pieces = Vec::with_capacity(lit.len() + knots.len());
         let (mut a, mut k) = (start, knots.partition_point(|kn| kn.0 <= start));
