@@ -88,18 +88,23 @@ fn rough_dielectric_samples_follow_its_pdf_both_ways_and_sides() {
     check_all("roughdielectric", cases);
 }
 
-#[test]
-fn plastics_lambertian_and_phong_samples_follow_their_pdfs() {
-    let mut cases = Vec::new();
-    let phong = Phong {
+/// The Phong material these tests sample, with mirror reflectance `mirror`.
+fn phong(mirror: f32) -> Phong {
+    Phong {
         color: Color::new(0.9, 0.6, 0.3),
         ambient: 0.0,
         diffuse: 0.4,
         specular: 0.3,
         metalness: 0.2,
         shininess: 20.0,
-        mirror: 0.2,
-    };
+        mirror,
+    }
+}
+
+#[test]
+fn plastics_lambertian_and_phong_samples_follow_their_pdfs() {
+    let mut cases = Vec::new();
+    let phong = phong(0.2);
     let mut materials = vec![
         ("lambertian".to_string(), Material::Lambertian { rho: Color::new(0.8, 0.5, 0.2) }),
         ("phong".to_string(), Material::Phong(phong)),
@@ -126,15 +131,7 @@ fn plastics_lambertian_and_phong_samples_follow_their_pdfs() {
 /// from both sides, a rough metal, a rough plastic's coat, Phong's lobe.
 #[test]
 fn glossy_lobes_sampled_at_given_points_follow_their_pdf() {
-    let phong = Phong {
-        color: Color::new(0.9, 0.6, 0.3),
-        ambient: 0.0,
-        diffuse: 0.4,
-        specular: 0.3,
-        metalness: 0.2,
-        shininess: 20.0,
-        mirror: 0.0,
-    };
+    let phong = phong(0.0);
     let mut materials = vec![("phong".to_string(), Material::Phong(phong))];
     for d in DISTRIBUTIONS {
         for (au, av) in ROUGHNESS {
