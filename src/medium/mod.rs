@@ -357,6 +357,10 @@ impl Medium {
 #[inline]
 fn exp_neg(sigma: Color, t: f32) -> Color {
     let x = |s: f32| if s > 0.0 { (-s * t).exp() } else { 1.0 };
+    // A grey medium's channels are one number: one exponential.
+    if sigma.x == sigma.y && sigma.y == sigma.z {
+        return Color::splat(x(sigma.x));
+    }
     Color::new(x(sigma.x), x(sigma.y), x(sigma.z))
 }
 

@@ -9,6 +9,7 @@
 use super::vol_file::VolGrid;
 use crate::math::{Color, Ray};
 use glam::{Affine3A, Vec3};
+use std::ops::{Add, AddAssign, Mul, Sub};
 use std::sync::Arc;
 
 /// How a grid is read between its cells (Mitsuba's `filter_type`).
@@ -166,6 +167,15 @@ impl Grid {
     /// The value at point `q` of the unit cube's coordinates.
     #[inline]
     fn eval_local(&self, q: Vec3) -> Color {
+        if self.data.channels == 1 {
+            Color::splat(self.lookup::<f32>(q))
+        } else {
+            self.lookup::<Color>(q)
+        }
+    }
+
+    #[inline]
+    fn lookup<T: Texel>(&self, q: Vec3) -> T {
         let res = Vec3::from_array(self.data.res.map(|r| r as f32));
         match self.filter {
             Filter::Nearest => {
@@ -183,16 +193,11 @@ impl Grid {
 
     /// Cell (`x`, `y`, `z`)'s value, read by the wrap mode.
     #[inline]
-    fn cell(&self, x: i32, y: i32, z: i32) -> Color {
+    fn cell<T: Texel>(&self, x: i32, y: i32, z: i32) -> T {
         let [nx, ny, nz] = self.data.res.map(|r| r as i32);
         let (x, y, z) = (wrap(x, nx, self.wrap), wrap(y, ny, self.wrap), wrap(z, nz, self.wrap));
-        let channels = self.data.channels as usize;
-        let i = ((z as usize * ny as usize + y as usize) * nx as usize + x as usize) * channels;
-        if channels == 1 {
-            Color::splat(self.data.data[i])
-        } else {
-            Color::new(self.data.data[i], self.data.data[i + 1], self.data.data[i + 2])
-        }
+        let i = (z as usize * ny as usize + y as usize) * nx as usize + x as usize;
+        T::read(&self.data.data, i * self.data.channels as usize)
     }
 
     /// World to the grid's unit cube.
@@ -209,7 +214,11 @@ impl Grid {
         for z in lo[2]..=hi[2] {
             for y in lo[1]..=hi[1] {
                 for x in lo[0]..=hi[0] {
-                    m = m.max(self.cell(x, y, z).max_element());
+                    let v = match self.data.channels {
+                        1 => self.cell::<f32>(x, y, z),
+                        _ => self.cell::<Color>(x, y, z).max_element(),
+                    };
+                    m = m.max(v);
                 }
             }
         }
@@ -218,16 +227,65 @@ impl Grid {
 
     /// The eight cells from `c` to `c` + (1, 1, 1), x fastest.
     #[inline]
-    fn corners(&self, c: Vec3) -> [Color; 8] {
+    fn corners<T: Texel>(&self, c: Vec3) -> [T; 8] {
+        let [nx, ny, nz] = self.data.res.map(|r| r as i32);
         let (x, y, z) = (c.x as i32, c.y as i32, c.z as i32);
-        std::array::from_fn(|i| self.cell(x + (i & 1) as i32, y + ((i >> 1) & 1) as i32, z + ((i >> 2) & 1) as i32))
+        let axis = |i: i32, n: i32| [wrap(i, n, self.wrap) as usize, wrap(i.saturating_add(1), n, self.wrap) as usize];
+        let (xs, ys, zs) = (axis(x, nx), axis(y, ny), axis(z, nz));
+        let (nx, ny, channels) = (nx as usize, ny as usize, self.data.channels as usize);
+        std::array::from_fn(|i| {
+            let at = (zs[i >> 2] * ny + ys[(i >> 1) & 1]) * nx + xs[i & 1];
+            T::read(&self.data.data, at * channels)
+        })
+    }
+}
+
+/// A grid's value as the arithmetic reads it: a one-channel grid's as one
+/// number, three times cheaper than a colour of three equal channels and
+/// the same to the bit (glam's `Vec3` computes channel by channel).
+trait Texel: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<f32, Output = Self> + AddAssign {
+    const ZERO: Self;
+    fn read(data: &[f32], at: usize) -> Self;
+    fn max_element(self) -> f32;
+    fn color(self) -> Color;
+}
+
+impl Texel for f32 {
+    const ZERO: f32 = 0.0;
+    #[inline]
+    fn read(data: &[f32], at: usize) -> f32 {
+        data[at]
+    }
+    #[inline]
+    fn max_element(self) -> f32 {
+        self
+    }
+    #[inline]
+    fn color(self) -> Color {
+        Color::splat(self)
+    }
+}
+
+impl Texel for Color {
+    const ZERO: Color = Color::ZERO;
+    #[inline]
+    fn read(data: &[f32], at: usize) -> Color {
+        Color::new(data[at], data[at + 1], data[at + 2])
+    }
+    #[inline]
+    fn max_element(self) -> f32 {
+        Vec3::max_element(self)
+    }
+    #[inline]
+    fn color(self) -> Color {
+        self
     }
 }
 
 /// Trilinear interpolation of `v` (x fastest) at weights `w`.
 #[inline]
-fn trilerp(v: &[Color; 8], w: Vec3) -> Color {
-    let lerp = |a: Color, b: Color, t: f32| a + (b - a) * t;
+fn trilerp<T: Texel>(v: &[T; 8], w: Vec3) -> T {
+    let lerp = |a: T, b: T, t: f32| a + (b - a) * t;
     let x00 = lerp(v[0], v[1], w.x);
     let x10 = lerp(v[2], v[3], w.x);
     let x01 = lerp(v[4], v[5], w.x);
@@ -247,7 +305,16 @@ impl Grid {
     /// whose integral exceeds `fine` in some channel is cut into equal
     /// parts below it, so that a reader interpolating between the
     /// pieces' ends errs little.
-    pub fn integrate(&self, ray: &Ray, t0: f32, t1: f32, fine: f32, mut piece: impl FnMut(f32, Color)) -> Color {
+    pub fn integrate(&self, ray: &Ray, t0: f32, t1: f32, fine: f32, piece: impl FnMut(f32, Color)) -> Color {
+        if self.data.channels == 1 {
+            self.integrate_as::<f32>(ray, t0, t1, fine, piece).color()
+        } else {
+            self.integrate_as::<Color>(ray, t0, t1, fine, piece)
+        }
+    }
+
+    #[inline]
+    fn integrate_as<T: Texel>(&self, ray: &Ray, t0: f32, t1: f32, fine: f32, mut piece: impl FnMut(f32, Color)) -> T {
         let res = Vec3::from_array(self.data.res.map(|r| r as f32));
         let shift = match self.filter {
             Filter::Trilinear => 0.5,
@@ -273,7 +340,7 @@ impl Grid {
         // ±1/√3 of the half-width), the nearest cell's constant exactly.
         let node = 1.0 / 3f32.sqrt();
         let filter = self.filter;
-        let integral = |a: f32, b: f32, cells: &[Color; 8], c: Vec3| -> Color {
+        let integral = |a: f32, b: f32, cells: &[T; 8], c: Vec3| -> T {
             match filter {
                 Filter::Nearest => cells[0] * (b - a),
                 Filter::Trilinear => {
@@ -293,7 +360,7 @@ impl Grid {
         };
         // At most one piece per plane crossed, and the last.
         let bound = ((dg.abs() * (t1 - t0)).element_sum() + 4.0).min(1e7) as usize;
-        let mut sum = Color::ZERO;
+        let mut sum = T::ZERO;
         let mut t = t0;
         for _ in 0..bound {
             let end = next.min_element().min(t1).max(t);
@@ -305,11 +372,11 @@ impl Grid {
                 for i in 0..n {
                     let (a, b) = (t + i as f32 * h, if i + 1 == n { end } else { t + (i + 1) as f32 * h });
                     sum += integral(a, b, &cells, c);
-                    piece(b, sum);
+                    piece(b, sum.color());
                 }
             } else {
                 sum += whole;
-                piece(end, sum);
+                piece(end, sum.color());
             }
             if !(end < t1) {
                 break;
