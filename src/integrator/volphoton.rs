@@ -330,7 +330,8 @@ impl VolPhotonIntegrator<'_> {
                 sum += c.photon.power * (f * c.kernel) * med.transmittance_to(steps, c.t);
             }
         });
-        sum += self.volume.integrate(m, &med.phase, ray, t_max, |t| med.transmittance_to(steps, t));
+        let mut cursor = 0;
+        sum += self.volume.integrate(m, &med.phase, ray, t_max, |t| med.transmittance_along(steps, &mut cursor, t));
         // The samples stratified along the segment (in the distances'
         // distribution, transmittance times where the lights reach): a
         // shaft of light crossing a small part of it is met by most of

@@ -202,6 +202,9 @@ pub struct LitSegment {
     /// medium's): uniform within each piece, whose mass is its weight
     /// times the fall of the channel's transmittance over it.
     tracked: bool,
+    /// The lit grid's pieces while the tracked ones are cut from them (kept
+    /// between segments: no allocation per segment).
+    spare: Vec<(f32, f32)>,
 }
 
 /// ∫ₐ^{a+len} e^{-σ (s - a)} ds, stable for small σ len.
@@ -299,13 +302,15 @@ impl LitSegment {
     /// missed the dense puffs of a smoke and piled into its thin parts,
     /// whose σ_s then weighed them down.
     fn build_tracked(&mut self, knots: &[(f32, Color)], start: f32) -> bool {
-        let at = |t: f32| super::segment::between_knots(knots, t);
+        let mut cursor = 0;
+        let mut at = |t: f32| super::segment::between_knots_from(knots, &mut cursor, t);
         // Channels whose transmittance falls alike all along are drawn as
         // one (a grey medium's).
         let grey = knots.iter().all(|k| k.1.x == k.1.y && k.1.y == k.1.z);
         let channels: &[usize] = if grey { &[0] } else { &[0, 1, 2] };
         let lit = std::mem::take(&mut self.pieces);
-        let mut pieces = Vec::with_capacity(lit.len() + knots.len());
+        let mut pieces = std::mem::take(&mut self.spare);
+        pieces.clear();
         let (mut a, mut k) = (start, knots.partition_point(|kn| kn.0 <= start));
         for &(end, w) in &lit {
             while a < end {
@@ -320,6 +325,7 @@ impl LitSegment {
             }
         }
         self.pieces = pieces;
+        self.spare = lit;
         self.start = start;
         self.count = 0;
         for &c in channels {

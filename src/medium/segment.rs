@@ -111,6 +111,17 @@ impl Medium {
             Kind::Heterogeneous { .. } => between_knots(&steps.steps, t),
         }
     }
+
+    /// [`Self::transmittance_to`] for distances that only grow along the
+    /// segment, `cursor` (0 at first) kept between them: the same values
+    /// without a search each.
+    #[inline]
+    pub fn transmittance_along(&self, steps: &Steps, cursor: &mut usize, t: f32) -> Color {
+        match self.kind {
+            Kind::Homogeneous { .. } => self.transmittance_to(steps, t),
+            Kind::Heterogeneous { .. } => between_knots_from(&steps.steps, cursor, t),
+        }
+    }
 }
 
 /// The transmittance at `t` read from a heterogeneous segment's `knots`
@@ -118,7 +129,30 @@ impl Medium {
 /// 1 before the first, the last after it.
 #[inline]
 pub(super) fn between_knots(knots: &[(f32, Color)], t: f32) -> Color {
-    match knots.partition_point(|s| s.0 <= t) {
+    interpolate(knots, knots.partition_point(|s| s.0 <= t), t)
+}
+
+/// [`between_knots`] for distances that only grow: `cursor` is where the
+/// last one fell, and the search walks on from it (the same index as the
+/// binary search; it starts over if a distance goes back).
+#[inline]
+pub(super) fn between_knots_from(knots: &[(f32, Color)], cursor: &mut usize, t: f32) -> Color {
+    let mut i = *cursor;
+    if i > knots.len() || (i > 0 && !(knots[i - 1].0 <= t)) {
+        i = knots.partition_point(|s| s.0 <= t);
+    } else {
+        while i < knots.len() && knots[i].0 <= t {
+            i += 1;
+        }
+    }
+    *cursor = i;
+    interpolate(knots, i, t)
+}
+
+/// The interpolation between knots `i` - 1 and `i` at `t`.
+#[inline]
+fn interpolate(knots: &[(f32, Color)], i: usize, t: f32) -> Color {
+    match i {
         0 => Color::ONE,
         i if i == knots.len() => knots[i - 1].1,
         i => {

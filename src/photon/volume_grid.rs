@@ -102,7 +102,7 @@ impl VolumeGrid {
     /// The light medium `m` (of phase function `phase`) scatters towards
     /// the eye along `ray` over [0, `t_max`], each distance weighed by
     /// `tr`, the transmittance from the ray's origin to it.
-    pub fn integrate(&self, m: u32, phase: &Phase, ray: &Ray, t_max: f32, tr: impl Fn(f32) -> Color) -> Color {
+    pub fn integrate(&self, m: u32, phase: &Phase, ray: &Ray, t_max: f32, tr: impl FnMut(f32) -> Color) -> Color {
         match self.grids.get(m as usize) {
             Some(Some(g)) => g.integrate(phase.mean_cosine(), ray, t_max, tr),
             _ => Color::ZERO,
@@ -197,7 +197,7 @@ impl MediumGrid {
         out
     }
 
-    fn integrate(&self, g: f32, ray: &Ray, t_max: f32, tr: impl Fn(f32) -> Color) -> Color {
+    fn integrate(&self, g: f32, ray: &Ray, t_max: f32, mut tr: impl FnMut(f32) -> Color) -> Color {
         let cells = Vec3::new(self.n[0] as f32, self.n[1] as f32, self.n[2] as f32);
         let hi = self.lo + self.h * cells;
         let Some((t0, t1)) = (Aabb { lo: self.lo, hi }).clip(ray, t_max) else { return Color::ZERO };
