@@ -30,7 +30,7 @@ use super::Context;
 use crate::material::Transport;
 use crate::math::{max_component, Color, Frame, Ray};
 use crate::medium::Media;
-use crate::photon::irradiance_cache::IrradianceCache;
+use crate::photon::irradiance_cache::{CellRange, IrradianceCache};
 use crate::sampling::{cosine_hemisphere, next_2d, stratified_2d};
 use crate::scene::{Hit, Scene};
 use crate::shape::Departure;
@@ -40,6 +40,18 @@ use std::f32::consts::PI;
 /// A gather ray's events (surfaces met, crossings) are cut after this
 /// many: light trapped by total internal reflection, a negligible share.
 const MAX_GATHER_EVENTS: u32 = 24;
+
+/// A gather ray's read of the irradiance cache, left until the vertex's
+/// rays are all traced: which ray, what the irradiance is multiplied by
+/// (the transmittance and the reflecting surface's albedo / π), where.
+#[derive(Clone, Copy, Debug)]
+pub struct PendingGather {
+    ray: u32,
+    weight: Color,
+    point: glam::Vec3,
+    normal: glam::Vec3,
+    cell: CellRange,
+}
 
 impl VolPhotonIntegrator<'_> {
     /// Radiance a diffuse vertex `hit` (normal `n`, in medium `medium` on
@@ -53,6 +65,7 @@ impl VolPhotonIntegrator<'_> {
         n: glam::Vec3,
         medium: Option<u32>,
         sequence: Option<(u64, u64)>,
+        pending: &mut Vec<PendingGather>,
         ctx: &mut Context,
     ) -> Color {
         let count = self.gather_rays;
@@ -60,7 +73,7 @@ impl VolPhotonIntegrator<'_> {
             return Color::ZERO;
         }
         let frame = Frame::from_normal(n);
-        let mut sum = Color::ZERO;
+        pending.clear();
         let sequence = sequence.map(|(index, scramble)| GatherSequence::new(index, scramble, count));
         for g in 0..count {
             let u = match &sequence {
@@ -75,25 +88,45 @@ impl VolPhotonIntegrator<'_> {
             }
             let start = self.media.after(medium, hit.prim, hit.normal, dir);
             let (ray, dep) = hit.spawn(dir);
-            sum += self.gather_ray(cache, ray, dep, start, ctx);
+            self.gather_ray(cache, g, ray, dep, start, pending, ctx);
         }
+        // The reads, left until every ray was traced so that their cache
+        // misses overlap: first each slot (fetched since the hit), which
+        // starts fetching its points, then the points. Summed ray by ray in
+        // the rays' order, as they would have been at once.
+        for r in pending.iter_mut() {
+            r.cell = cache.locate(r.point);
+        }
+        let mut sum = Color::ZERO;
+        let (mut ray, mut found) = (0, Color::ZERO);
+        for r in pending.iter() {
+            if r.ray != ray {
+                sum += found;
+                (ray, found) = (r.ray, Color::ZERO);
+            }
+            let e = self.cached_in(cache, r.point, r.normal, r.cell, ctx);
+            found += r.weight * ctx.checked(e, "gather");
+        }
+        sum += found;
         sum / count as f32
     }
 
     /// Radiance arriving along one gather ray from diffuse lobes' light
     /// (see the module's table): followed through mirrors, glass and
     /// index-matched crossings, with the media's transmittance.
+    #[allow(clippy::too_many_arguments)]
     fn gather_ray(
         &self,
         cache: &IrradianceCache,
+        index: u32,
         mut ray: Ray,
         mut dep: Departure,
         mut medium: Option<u32>,
+        pending: &mut Vec<PendingGather>,
         ctx: &mut Context,
-    ) -> Color {
+    ) {
         let (scene, media) = (self.scene, self.media);
         let mut weight = Color::ONE;
-        let mut found = Color::ZERO;
         for _ in 0..MAX_GATHER_EVENTS {
             ctx.counters.rays += 1;
             let Some(y) = scene.intersect(&ray, Some(dep)) else { break };
@@ -112,8 +145,14 @@ impl VolPhotonIntegrator<'_> {
             let wo = frame.to_local(-ray.dir);
             if material.diffuse_rho().is_some() {
                 let rho = material.diffuse_albedo(wo);
-                let e = self.cached(cache, y.point, frame.n, ctx);
-                found += weight * rho / PI * ctx.checked(e, "gather");
+                cache.prefetch_cell(y.point);
+                pending.push(PendingGather {
+                    ray: index,
+                    weight: weight * rho / PI,
+                    point: y.point,
+                    normal: frame.n,
+                    cell: CellRange::default(),
+                });
             }
             // On through a mirror, glass or an index-matched crossing; a
             // glossy lobe's light is the surface map's at x.
@@ -128,14 +167,25 @@ impl VolPhotonIntegrator<'_> {
             medium = media.after(medium, y.prim, y.normal, dir);
             (ray, dep) = y.spawn(dir);
         }
-        found
     }
 
     /// The photons' irradiance at `point` from the cache, read from a
     /// cache point no surface hides from it.
     pub(super) fn cached(&self, cache: &IrradianceCache, point: glam::Vec3, n: glam::Vec3, ctx: &mut Context) -> Color {
+        self.cached_in(cache, point, n, cache.locate(point), ctx)
+    }
+
+    /// [`Self::cached`] with `point`'s cell already found.
+    fn cached_in(
+        &self,
+        cache: &IrradianceCache,
+        point: glam::Vec3,
+        n: glam::Vec3,
+        cell: CellRange,
+        ctx: &mut Context,
+    ) -> Color {
         let scene = self.scene;
-        cache.lookup_seen(point, n, cache.locate(point), |from, to| {
+        cache.lookup_seen(point, n, cell, |from, to| {
             let (dir, len) = ((to - from).normalize_or_zero(), from.distance(to));
             ctx.counters.rays += 1;
             ctx.counters.cache_rays += 1;

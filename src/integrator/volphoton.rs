@@ -95,6 +95,7 @@ pub struct VolPhotonThread {
     scratch: Scratch,
     steps: Steps,
     lit: LitSegment,
+    gathered: Vec<super::volgather::PendingGather>,
 }
 
 /// Where the lights reach into medium `m`: over the scene's bounds, each
@@ -257,7 +258,7 @@ impl VolPhotonIntegrator<'_> {
                     };
                     reflected += ctx.checked(r, "surface map");
                     if let Some(cache) = self.cache {
-                        let g = self.gather(cache, &hit, frame.n, medium, vertex_sequence, ctx);
+                        let g = self.gather(cache, &hit, frame.n, medium, vertex_sequence, &mut thread.gathered, ctx);
                         reflected += rho * g;
                     }
                 }
