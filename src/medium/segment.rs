@@ -171,6 +171,33 @@ mod tests {
     use glam::{Affine3A, Vec3};
     use rand::RngExt;
 
+    /// The cursor's walk finds what the binary search finds, for distances
+    /// that grow (as the camera pass reads them), stand still, go back, or
+    /// fall before the first knot and past the last; knots that share a
+    /// distance included.
+    #[test]
+    fn reading_knots_with_a_cursor_is_reading_them_by_search() {
+        let mut rng = stream(9, Domain::Camera, 2);
+        for _ in 0..200 {
+            let mut t = rng.random::<f32>();
+            let knots: Vec<(f32, Color)> = (0..rng.random_range(0..12))
+                .map(|_| {
+                    if rng.random::<f32>() < 0.8 {
+                        t += rng.random::<f32>();
+                    }
+                    (t, Color::new(rng.random(), rng.random(), rng.random()))
+                })
+                .collect();
+            let mut cursor = 0;
+            let mut x = -0.5;
+            for _ in 0..40 {
+                x += rng.random::<f32>() * 1.5 - if rng.random::<f32>() < 0.2 { 2.0 } else { 0.0 };
+                let x = if rng.random::<f32>() < 0.1 && !knots.is_empty() { knots[rng.random_range(0..knots.len())].0 } else { x };
+                assert_eq!(between_knots_from(&knots, &mut cursor, x), between_knots(&knots, x), "{x} {knots:?}");
+            }
+        }
+    }
+
     /// The transmittance read from a homogeneous segment's table is
     /// Beer–Lambert's within 0.05%, short
     /// segments and long, grey and chromatic.
