@@ -58,6 +58,7 @@ impl VolPhotonIntegrator<'_> {
     /// the side the camera path arrived from) reflects of light whose last
     /// non-specular vertex was a diffuse lobe's, over its albedo: the mean
     /// of the gather rays' radiance.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn gather(
         &self,
         cache: &IrradianceCache,

@@ -192,7 +192,11 @@ mod tests {
             let mut x = -0.5;
             for _ in 0..40 {
                 x += rng.random::<f32>() * 1.5 - if rng.random::<f32>() < 0.2 { 2.0 } else { 0.0 };
-                let x = if rng.random::<f32>() < 0.1 && !knots.is_empty() { knots[rng.random_range(0..knots.len())].0 } else { x };
+                let x = if rng.random::<f32>() < 0.1 && !knots.is_empty() {
+                    knots[rng.random_range(0..knots.len())].0
+                } else {
+                    x
+                };
                 assert_eq!(between_knots_from(&knots, &mut cursor, x), between_knots(&knots, x), "{x} {knots:?}");
             }
         }
