@@ -27,14 +27,14 @@ pub(super) fn gather_density(cos: f32, nc: u32, na: u32, aimed_pdf: impl FnOnce(
 /// rays stay stratified over the hemisphere across passes, where rays
 /// drawn anew each pass add independent noise. Each point on its own is
 /// uniform: unbiased.
-pub(crate) struct GatherSequence {
+pub struct GatherSequence {
     /// The unscrambled bits of the block's first point.
     base: [u32; 2],
     key: u64,
 }
 
 impl GatherSequence {
-    pub(crate) fn new(index: u64, scramble: u64, count: u32) -> Self {
+    pub fn new(index: u64, scramble: u64, count: u32) -> Self {
         let key = splitmix64(scramble ^ GATHER_SEQUENCE);
         let shift = count.max(1).next_power_of_two().trailing_zeros();
         let sample = shuffled_index(index as u32, (key >> 32) as u32);
@@ -44,7 +44,7 @@ impl GatherSequence {
     }
 
     /// Ray `g`'s point (`g` below the block's size).
-    pub(crate) fn point(&self, g: u32) -> glam::Vec2 {
+    pub fn point(&self, g: u32) -> glam::Vec2 {
         let [x, y] = sobol_2d_bits(g);
         owen_2d([self.base[0] ^ x, self.base[1] ^ y], self.key)
     }
@@ -240,10 +240,10 @@ impl<'a> PhotonIntegrator<'a> {
                         let shared = g.eval(wo, wi, entering, Transport::Radiance);
                         MisBsdf { alone: Color::ZERO, shared, pdf: (1.0 - p_specular) * g.pdf(wo, wi, entering) }
                     };
-                    direct_light_mis(self.scene, &y, frame.n, bsdf, s.shadow_rays, s.skip, both, sh.ctx)
+                    direct_light_mis(self.scene, &y, frame.n, bsdf, s.shadow_rays, s.skip, both, None, sh.ctx)
                 } else {
                     let brdf = |l: glam::Vec3| g.eval(wo, frame.to_local(l), entering, Transport::Radiance);
-                    direct_light(self.scene, &y, frame.n, brdf, s.shadow_rays, s.skip, both, sh.ctx)
+                    direct_light(self.scene, &y, frame.n, brdf, s.shadow_rays, s.skip, both, None, sh.ctx)
                 };
                 found += weight * direct;
             }
