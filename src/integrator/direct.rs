@@ -388,7 +388,7 @@ mod tests {
             let n = hit.facing_normal(dir);
             let (mut counters, mut r) = (Counters::default(), stream(23, Domain::Camera, i));
             let mut ctx = Context { rng: &mut r, counters: &mut counters, pixel: i };
-            let mut estimate = |q: Option<&GatherSequence>, ctx: &mut Context| {
+            let estimate = |q: Option<&GatherSequence>, ctx: &mut Context| {
                 direct_light(&scene, &hit, n, brdf, count, true, false, q, ctx).x as f64
             };
             // Points wholly lit or wholly dark have no noise to cut.

@@ -31,6 +31,10 @@ pub struct GatherSequence {
     /// The unscrambled bits of the block's first point.
     base: [u32; 2],
     key: u64,
+    /// The block's size less one.
+    mask: u32,
+    /// Where in the block ray 0 reads ([`GatherSequence::rotated`]).
+    offset: u32,
 }
 
 impl GatherSequence {
@@ -40,12 +44,30 @@ impl GatherSequence {
         let sample = shuffled_index(index as u32, (key >> 32) as u32);
         // Past 2^32 points the sequence starts over (at 4 rays, a pixel's
         // billionth sample).
-        GatherSequence { base: sobol_2d_bits(sample.wrapping_shl(shift)), key }
+        GatherSequence { base: sobol_2d_bits(sample.wrapping_shl(shift)), key, mask: (1 << shift) - 1, offset: 0 }
+    }
+
+    /// The sequence for `used` rays (the first `used` of
+    /// [`GatherSequence::point`]'s): where they are fewer than the block's
+    /// points (cosine rays beside aimed ones, a count not a power of two),
+    /// they read the block cyclically from a random place in it. Read from
+    /// its start, ray `g` would always take the block's point `g`, whose
+    /// leading bits are `g`'s and which the pixel's scramble maps to the
+    /// same stratum of the square at every sample: the strata of the
+    /// points no ray reads would never be sampled in that pixel, an error
+    /// of each pixel's (unbiased only over pixels) that no number of
+    /// passes averages out. From a random place each of the block's points
+    /// is read with the same chance: each pixel's estimate converges.
+    pub fn rotated(mut self, used: u32, rng: &mut crate::sampling::Rng) -> Self {
+        if used <= self.mask {
+            self.offset = rng.random::<u32>() & self.mask;
+        }
+        self
     }
 
     /// Ray `g`'s point (`g` below the block's size).
     pub fn point(&self, g: u32) -> glam::Vec2 {
-        let [x, y] = sobol_2d_bits(g);
+        let [x, y] = sobol_2d_bits(g.wrapping_add(self.offset) & self.mask);
         owen_2d([self.base[0] ^ x, self.base[1] ^ y], self.key)
     }
 }
@@ -89,7 +111,10 @@ impl<'a> PhotonIntegrator<'a> {
         // with cosine rays alone, 1 / count.
         let (nc, na) = (cosine as f32, aimed as f32);
         let mut sum = Color::ZERO;
-        let sequence = sh.pixel.sequence.map(|(index, scramble)| GatherSequence::new(index, scramble, count));
+        let sequence = sh
+            .pixel
+            .sequence
+            .map(|(index, scramble)| GatherSequence::new(index, scramble, count).rotated(cosine, sh.ctx.rng));
         for g in 0..count {
             let dir = if g < cosine {
                 let u = match &sequence {
@@ -386,6 +411,28 @@ mod tests {
             for g in 0..4 {
                 let expected = crate::sampling::sobol_owen_2d(sample.wrapping_mul(4).wrapping_add(g), key);
                 assert_eq!(GatherSequence::new(index, scramble, 3).point(g), expected, "{index}, {g}");
+            }
+        }
+    }
+
+    /// Within one pixel (one scramble), 3 rays of a block of 4 read every
+    /// quarter of the square equally often over its samples: read from the
+    /// block's start, one quarter would never be read (counts 1/3, 1/3,
+    /// 1/3, 0).
+    #[test]
+    fn fewer_rays_than_the_block_read_all_of_it_in_each_pixel() {
+        let mut rng = stream(4, Domain::Camera, 0);
+        for scramble in [1u64, 0xDEAD_BEEF, u64::MAX / 3] {
+            let (samples, mut quarters) = (4096u64, [0u32; 4]);
+            for index in 0..samples {
+                let q = GatherSequence::new(index, scramble, 4).rotated(3, &mut rng);
+                for g in 0..3 {
+                    quarters[(q.point(g).x * 4.0) as usize] += 1;
+                }
+            }
+            for c in quarters {
+                let share = c as f64 / (3 * samples) as f64;
+                assert!((share - 0.25).abs() < 0.02, "{quarters:?}, scramble {scramble:#x}");
             }
         }
     }

@@ -349,10 +349,9 @@ impl<'a> PhotonIntegrator<'a> {
         // keyed apart from its gather rays' and glossy samples' (see
         // `direct_light`): a penumbra's light stays stratified over the
         // pixel's samples and passes.
-        let points = sh
-            .pixel
-            .sequence
-            .map(|(index, scramble)| GatherSequence::new(index, scramble ^ SHADOW_SEQUENCE, s.shadow_rays));
+        let points = sh.pixel.sequence.map(|(index, scramble)| {
+            GatherSequence::new(index, scramble ^ SHADOW_SEQUENCE, s.shadow_rays).rotated(s.shadow_rays, sh.ctx.rng)
+        });
         let points = points.as_ref();
         let direct = match mis {
             Some(g) => {
@@ -419,7 +418,8 @@ impl<'a> PhotonIntegrator<'a> {
             // normal lines the second's lobe up with the light: random
             // normals left it in rare bright samples.
             let sequence = sh.pixel.sequence.filter(|_| s.stratify_glossy).map(|(index, scramble)| {
-                let at = |key| GatherSequence::new(index, scramble ^ key, glossy_rays);
+                let mut at =
+                    |key| GatherSequence::new(index, scramble ^ key, glossy_rays).rotated(glossy_rays, sh.ctx.rng);
                 (at(GLOSSY_SEQUENCE), at(GLOSSY_SEQUENCE_NEXT))
             });
             for r in 0..glossy_rays {
