@@ -65,6 +65,20 @@ impl GatherSequence {
         self
     }
 
+    /// The sequence read cyclically from a random place in its block, at
+    /// any count of rays: for a second sequence that the same rays read
+    /// after a first (each glossy ray's next glossy sample). Ray `g`'s
+    /// point of each block falls, for a pixel, in a quarter of the square
+    /// fixed by `g`: read both from the start, ray `g`'s first point and
+    /// its second would pair the same quarters at every sample, and
+    /// three in four of the pairs of quarters would never be drawn in
+    /// that pixel. From a random place each ray's second point is paired
+    /// with any of the block's points with the same chance.
+    pub fn from_random_place(mut self, rng: &mut crate::sampling::Rng) -> Self {
+        self.offset = rng.random::<u32>() & self.mask;
+        self
+    }
+
     /// Ray `g`'s point (`g` below the block's size).
     pub fn point(&self, g: u32) -> glam::Vec2 {
         let [x, y] = sobol_2d_bits(g.wrapping_add(self.offset) & self.mask);
@@ -433,6 +447,30 @@ mod tests {
             for c in quarters {
                 let share = c as f64 / (3 * samples) as f64;
                 assert!((share - 0.25).abs() < 0.02, "{quarters:?}, scramble {scramble:#x}");
+            }
+        }
+    }
+
+    /// Two sequences read by the same 4 rays, the second from a random
+    /// place: within one pixel, the rays' points pair every quarter of the
+    /// first square with every quarter of the second, each about as
+    /// often (read both from the start, 4 pairs of the 16 only).
+    #[test]
+    fn a_second_sequence_pairs_every_quarter_with_every_other_in_each_pixel() {
+        let mut rng = stream(5, Domain::Camera, 0);
+        for scramble in [1u64, 0xDEAD_BEEF] {
+            let (samples, mut pairs) = (8192u64, [0u32; 16]);
+            for index in 0..samples {
+                let first = GatherSequence::new(index, scramble, 4).rotated(4, &mut rng);
+                let second = GatherSequence::new(index, scramble ^ 0x77, 4).from_random_place(&mut rng);
+                for g in 0..4 {
+                    let (a, b) = (first.point(g), second.point(g));
+                    pairs[(a.x * 4.0) as usize * 4 + (b.x * 4.0) as usize] += 1;
+                }
+            }
+            for c in pairs {
+                let share = c as f64 / (4 * samples) as f64;
+                assert!((share - 1.0 / 16.0).abs() < 0.015, "{pairs:?}, scramble {scramble:#x}");
             }
         }
     }
