@@ -350,7 +350,7 @@ impl<'a> PhotonIntegrator<'a> {
         // `direct_light`): a penumbra's light stays stratified over the
         // pixel's samples and passes.
         let points = sh.pixel.sequence.map(|(index, scramble)| {
-            GatherSequence::new(index, scramble ^ SHADOW_SEQUENCE, s.shadow_rays).rotated(s.shadow_rays, sh.ctx.rng)
+            GatherSequence::new(index, scramble ^ SHADOW_SEQUENCE, s.shadow_rays).rotated(s.shadow_rays)
         });
         let points = points.as_ref();
         let direct = match mis {
@@ -421,7 +421,7 @@ impl<'a> PhotonIntegrator<'a> {
             // normals left it in rare bright samples.
             let sequence = sh.pixel.sequence.filter(|_| s.stratify_glossy).map(|(index, scramble)| {
                 let at = |key| GatherSequence::new(index, scramble ^ key, glossy_rays);
-                let first = at(GLOSSY_SEQUENCE).rotated(glossy_rays, sh.ctx.rng);
+                let first = at(GLOSSY_SEQUENCE).rotated(glossy_rays);
                 (first, at(GLOSSY_SEQUENCE_NEXT).from_random_place(sh.ctx.rng))
             });
             for r in 0..glossy_rays {
