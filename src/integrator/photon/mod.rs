@@ -413,16 +413,14 @@ impl<'a> PhotonIntegrator<'a> {
             // (keyed apart from theirs): stratified over the lobe within
             // the camera sample and across the pixel's samples and passes;
             // and so does the next glossy sample on each ray's path (a
-            // frosted ball's far side), from a second sequence read from a
-            // random place in its block (a ray's two points paired at
-            // random, `GatherSequence::from_random_place`). Light seen
+            // frosted ball's far side), from a second sequence. Light seen
             // through two rough surfaces is found where the first one's
             // normal lines the second's lobe up with the light: random
             // normals left it in rare bright samples.
             let sequence = sh.pixel.sequence.filter(|_| s.stratify_glossy).map(|(index, scramble)| {
                 let at = |key| GatherSequence::new(index, scramble ^ key, glossy_rays);
                 let first = at(GLOSSY_SEQUENCE).rotated(glossy_rays);
-                (first, at(GLOSSY_SEQUENCE_NEXT).from_random_place(sh.ctx.rng))
+                (first, at(GLOSSY_SEQUENCE_NEXT).rotated(glossy_rays))
             });
             for r in 0..glossy_rays {
                 let branches = match &sequence {
