@@ -110,10 +110,10 @@ impl Integrator for PathIntegrator<'_> {
                             let shared = material.eval(wo, wi, entering, Transport::Radiance);
                             MisBsdf { alone: Color::ZERO, shared, pdf: material.pdf(wo, wi, entering) }
                         };
-                        direct_light_mis(self.scene, &hit, n, bsdf, count, skip, both, ctx)
+                        direct_light_mis(self.scene, &hit, n, bsdf, count, skip, both, None, ctx)
                     } else {
                         let brdf = |w| material.eval(wo, frame.to_local(w), entering, Transport::Radiance);
-                        direct_light(self.scene, &hit, n, brdf, count, skip, both, ctx)
+                        direct_light(self.scene, &hit, n, brdf, count, skip, both, None, ctx)
                     };
                     radiance += throughput * ctx.checked(direct, "path direct");
                 }

@@ -34,7 +34,7 @@ use crate::shape::Departure;
 use rand::RngExt;
 use std::f32::consts::PI;
 
-pub(crate) mod gather;
+pub mod gather;
 use gather::{gather_density, GatherSequence};
 
 /// Keys the glossy lobe's sequence apart from the diffuse gather rays'
@@ -43,6 +43,10 @@ const GLOSSY_SEQUENCE: u64 = 0x6105_5EED_0000_0002;
 /// Keys the sequence of the glossy sample at the next vertex of each of
 /// those rays' paths.
 const GLOSSY_SEQUENCE_NEXT: u64 = 0x6105_5EED_0000_0003;
+
+/// Keys the shadow rays' sequence at a camera vertex apart from the
+/// others.
+const SHADOW_SEQUENCE: u64 = 0x6105_5EED_0000_0004;
 
 /// Camera paths split into both the reflected and refracted branch at their
 /// first glass vertices (no noise from the choice where it matters most);
@@ -341,6 +345,14 @@ impl<'a> PhotonIntegrator<'a> {
             && material.diffuse_rho().is_some()
             && s.gather_rays > 0
             && !self.cache.is_empty();
+        // The shadow rays take their points from a sequence of the pixel's,
+        // keyed apart from its gather rays' and glossy samples' (see
+        // `direct_light`): a penumbra's light stays stratified over the
+        // pixel's samples and passes.
+        let points = sh.pixel.sequence.map(|(index, scramble)| {
+            GatherSequence::new(index, scramble ^ SHADOW_SEQUENCE, s.shadow_rays).rotated(s.shadow_rays)
+        });
+        let points = points.as_ref();
         let direct = match mis {
             Some(g) => {
                 let bsdf = |w: glam::Vec3| {
@@ -349,7 +361,7 @@ impl<'a> PhotonIntegrator<'a> {
                     let alone = (material.eval(wo, wi, entering, Transport::Radiance) - shared).max(Color::ZERO);
                     MisBsdf { alone, shared, pdf: rays * g.pdf(wo, wi, entering) }
                 };
-                direct_light_mis(self.scene, hit, n, bsdf, s.shadow_rays, s.skip, both, sh.ctx)
+                direct_light_mis(self.scene, hit, n, bsdf, s.shadow_rays, s.skip, both, points, sh.ctx)
             }
             None if shares_with_gathering => {
                 // Light from everywhere is shared with the gather rays (all
@@ -363,11 +375,11 @@ impl<'a> PhotonIntegrator<'a> {
                     shared: material.eval(wo, frame.to_local(w), entering, Transport::Radiance),
                     pdf: gather_density(w.dot(n), nc, na, || aims.pdf(w)),
                 };
-                direct_light_shared(self.scene, hit, n, bsdf, s.shadow_rays, s.skip, both, sh.ctx)
+                direct_light_shared(self.scene, hit, n, bsdf, s.shadow_rays, s.skip, both, points, sh.ctx)
             }
             None => {
                 let brdf = |w: glam::Vec3| material.eval(wo, frame.to_local(w), entering, Transport::Radiance);
-                direct_light(self.scene, hit, n, brdf, s.shadow_rays, s.skip, both, sh.ctx)
+                direct_light(self.scene, hit, n, brdf, s.shadow_rays, s.skip, both, points, sh.ctx)
             }
         };
         let (mut caustic, mut indirect) = (Color::ZERO, Color::ZERO);
@@ -407,7 +419,8 @@ impl<'a> PhotonIntegrator<'a> {
             // normals left it in rare bright samples.
             let sequence = sh.pixel.sequence.filter(|_| s.stratify_glossy).map(|(index, scramble)| {
                 let at = |key| GatherSequence::new(index, scramble ^ key, glossy_rays);
-                (at(GLOSSY_SEQUENCE), at(GLOSSY_SEQUENCE_NEXT))
+                let first = at(GLOSSY_SEQUENCE).rotated(glossy_rays);
+                (first, at(GLOSSY_SEQUENCE_NEXT).rotated(glossy_rays))
             });
             for r in 0..glossy_rays {
                 let branches = match &sequence {
