@@ -75,7 +75,7 @@ impl VolPhotonIntegrator<'_> {
         }
         let frame = Frame::from_normal(n);
         pending.clear();
-        let sequence = sequence.map(|(index, scramble)| GatherSequence::new(index, scramble, count));
+        let sequence = sequence.map(|(index, scramble)| GatherSequence::new(index, scramble, count).rotated(count));
         for g in 0..count {
             let u = match &sequence {
                 Some(s) => s.point(g),

@@ -388,7 +388,8 @@ pub(super) fn surface_light(
     // A camera sample's shadow rays take their block of a sequence of the
     // pixel's, scrambled apart from its gather rays' (as those, they stay
     // stratified over the light across the pixel's samples and passes).
-    let sequence = sequence.map(|(index, scramble)| GatherSequence::new(index, scramble ^ SHADOW_SEQUENCE, count));
+    let sequence =
+        sequence.map(|(index, scramble)| GatherSequence::new(index, scramble ^ SHADOW_SEQUENCE, count).rotated(count));
     let mut sum = Color::ZERO;
     for s in 0..count {
         let point = sequence.as_ref().map(|q| q.point(s));
