@@ -338,6 +338,7 @@ pub fn photon_integrator<'a>(
             rough_splits: crate::integrator::photon::ROUGH_SPLITS,
             reflected_paths: crate::integrator::photon::REFLECTED_PATHS,
             stratify_glossy: true,
+            shadow_sequence_samples: settings.spp as u64,
         },
     }
 }
