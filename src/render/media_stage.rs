@@ -111,7 +111,15 @@ pub fn media_pass(
             let (map, sparse) = VolumeMap::build_dense(caustic.volume, VOLUME_K, r_volume, narrow, SPARSE_RADIUS);
             let n = sparse.len();
             global_volume.extend(sparse);
-            (VolumeGrid::build(&global_volume, VOLUME_K, r_volume, narrow), map, n)
+            // A heterogeneous medium's grid reads the light apart from the
+            // density, which is known exactly (notes/method.md §8).
+            let extinction: Vec<_> = media
+                .media
+                .iter()
+                .map(|med| (!med.is_homogeneous()).then_some(move |p| med.coefficients(p).0))
+                .collect();
+            let grid = VolumeGrid::build_weighed(&global_volume, VOLUME_K, r_volume, narrow, &extinction);
+            (grid, map, n)
         },
     );
     stats.tree_time += t.elapsed();

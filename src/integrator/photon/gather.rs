@@ -450,7 +450,6 @@ mod tests {
     /// 1/3, 0).
     #[test]
     fn fewer_rays_than_the_block_read_all_of_it_in_each_pixel() {
-        let mut rng = stream(4, Domain::Camera, 0);
         for scramble in [1u64, 0xDEAD_BEEF, u64::MAX / 3] {
             let (samples, mut quarters) = (4096u64, [0u32; 4]);
             for index in 0..samples {
