@@ -78,6 +78,18 @@ fn luminance(c: Color) -> f32 {
     crate::texture::luminance(c)
 }
 
+/// Corner `corner` (0-7: its x, y and z offsets as bits) of a cell: its
+/// offset from the cell's lowest vertex in a grid of `nx` × `ny` vertices
+/// a layer, and its trilinear weight at `f` (in [0, 1]³) within the cell.
+#[inline]
+fn corner(corner: usize, f: Vec3, nx: usize, ny: usize) -> (usize, f32) {
+    let (a, b, c) = (corner & 1, (corner >> 1) & 1, corner >> 2);
+    let w = (if a == 1 { f.x } else { 1.0 - f.x })
+        * (if b == 1 { f.y } else { 1.0 - f.y })
+        * (if c == 1 { f.z } else { 1.0 - f.z });
+    ((c * ny + b) * nx + a, w)
+}
+
 impl VolumeGrid {
     /// The grids of `photons`: per medium, cells of side [`SPACING`] times
     /// the radius of the sphere holding `k` photons at their mean density
@@ -243,12 +255,9 @@ impl MediumGrid {
             let f = u - cell;
             let (i, j, l) = (cell.x as usize, cell.y as usize, cell.z as usize);
             let dir = p.direction() * luminance(p.power);
-            for corner in 0..8 {
-                let (a, b, e) = (corner & 1, (corner >> 1) & 1, corner >> 2);
-                let w = (if a == 1 { f.x } else { 1.0 - f.x })
-                    * (if b == 1 { f.y } else { 1.0 - f.y })
-                    * (if e == 1 { f.z } else { 1.0 - f.z });
-                let at = ((l + e) * ny + j + b) * nx + i + a;
+            for c in 0..8 {
+                let (offset, w) = corner(c, f, nx, ny);
+                let at = (l * ny + j) * nx + i + offset;
                 let add = [p.power.x, p.power.y, p.power.z, dir.x, dir.y, dir.z];
                 for (s, a) in v[at].iter_mut().zip(add) {
                     *s += w * a;
@@ -331,12 +340,9 @@ impl MediumGrid {
         let nx = self.n[0] as usize + 1;
         let ny = self.n[1] as usize + 1;
         let mut halves = [0.0f64; 2];
-        for corner in 0..8 {
-            let (a, b, c) = (corner & 1, (corner >> 1) & 1, corner >> 2);
-            let w = (if a == 1 { f.x } else { 1.0 - f.x })
-                * (if b == 1 { f.y } else { 1.0 - f.y })
-                * (if c == 1 { f.z } else { 1.0 - f.z });
-            let h = self.halves[base + (c * ny + b) * nx + a];
+        for c in 0..8 {
+            let (offset, w) = corner(c, f, nx, ny);
+            let h = self.halves[base + offset];
             halves[0] += (w * h[0]) as f64;
             halves[1] += (w * h[1]) as f64;
         }
@@ -425,12 +431,9 @@ impl MediumGrid {
         let nx = n[0] as usize + 1;
         let ny = n[1] as usize + 1;
         let mut out = Color::ZERO;
-        for corner in 0..8 {
-            let (a, b, c) = (corner & 1, (corner >> 1) & 1, corner >> 2);
-            let w = (if a == 1 { f.x } else { 1.0 - f.x })
-                * (if b == 1 { f.y } else { 1.0 - f.y })
-                * (if c == 1 { f.z } else { 1.0 - f.z });
-            let s = e[base + (c * ny + b) * nx + a];
+        for c in 0..8 {
+            let (offset, w) = corner(c, f, nx, ny);
+            let s = e[base + offset];
             out += w * Color::new(s[0], s[1], s[2]);
         }
         out
@@ -443,12 +446,9 @@ impl MediumGrid {
         let nx = self.n[0] as usize + 1;
         let ny = self.n[1] as usize + 1;
         let mut out = [0.0f32; 6];
-        for corner in 0..8 {
-            let (a, b, e) = (corner & 1, (corner >> 1) & 1, corner >> 2);
-            let w = (if a == 1 { f.x } else { 1.0 - f.x })
-                * (if b == 1 { f.y } else { 1.0 - f.y })
-                * (if e == 1 { f.z } else { 1.0 - f.z });
-            let s = &self.v[base + (e * ny + b) * nx + a];
+        for c in 0..8 {
+            let (offset, w) = corner(c, f, nx, ny);
+            let s = &self.v[base + offset];
             for (o, x) in out.iter_mut().zip(s) {
                 *o += w * x;
             }
